@@ -1,0 +1,39 @@
+# Entry points for a fresh Debian 12 machine. `make test` installs what is missing, builds and runs
+# every test; `make bench` prints the speed figures.
+SHELL := /bin/bash
+# catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
+export PATH := /usr/bin:$(PATH)
+
+BUILD ?= build
+JOBS ?= $(shell nproc)
+SHARED_DATA ?= $(abspath ../shared/data)
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
+  libeigen3-dev libtbb-dev libyaml-cpp-dev libpcl-dev libgtest-dev gnuplot-nox \
+  libroscpp-dev libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev \
+  libpcl-ros-dev libpcl-conversions-dev librostest-dev python3-rostest libsensor-msgs-dev \
+  libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster
+
+.PHONY: deps build test bench clean
+
+# Installs only what is missing, so a second run needs no network.
+deps:
+	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "Installing:" $$missing; \
+	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $$missing; \
+	fi
+
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_SHARED_DATA=$(SHARED_DATA)
+	cmake --build $(BUILD) -j$(JOBS)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+bench: build
+	tools/bench.sh $(BUILD) $(SHARED_DATA)
+
+clean:
+	rm -rf $(BUILD)

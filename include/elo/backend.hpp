@@ -1,0 +1,67 @@
+// The per-frame stages of the pipeline behind one interface, so that the threaded CPU kernels and the
+// CUDA kernels are interchangeable. A backend owns the current scan and the model; the Gauss-Newton loop
+// (registration.hpp) and the motion prior live above it and are shared.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+
+#include "elo/config.hpp"
+#include "elo/se3.hpp"
+#include "elo/types.hpp"
+
+namespace elo {
+
+// The reductions of one Gauss-Newton step, per cost term, before fusion (Eq. 1-2). Sums over the
+// correspondences that passed the gates; `candidates` counts the points that were tried.
+struct TermSums {
+  Matrix6d JtJ = Matrix6d::Zero();
+  Vector6d Jte = Vector6d::Zero();
+  double squared_error = 0.0;
+  int candidates = 0;
+  int inliers = 0;
+
+  double inlierRatio() const { return candidates > 0 ? static_cast<double>(inliers) / candidates : 0.0; }
+  TermSums& operator+=(const TermSums& other);
+};
+
+struct NormalEquations {
+  TermSums nonground;  // E_S: scan SRI against the model SRI
+  TermSums ground;     // E_G: scan BEV against the model BEV
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual const char* name() const = 0;
+
+  // Sec. III-B.1: spherical projection of the cloud (closest point per pixel). `stamp` is the scan's
+  // time in seconds since the first scan; it becomes the observation time of every vertex. Returns the
+  // number of occupied pixels.
+  virtual size_t projectScan(const PointCloud& cloud, float stamp) = 0;
+  // Sec. III-C.1: labels every occupied pixel ground or non-ground.
+  virtual void segmentGround() = 0;
+  // Sec. III-B.3-4: normals and curvature gating of the non-ground pixels.
+  virtual void estimateNormals() = 0;
+  // Sec. III-C.2: the BEV map of the ground pixels.
+  virtual void buildGroundMap() = 0;
+  // Sec. III-A: the sums of one Gauss-Newton step with the scan moved by `model_from_scan` (T^{t-1}_t),
+  // residuals weighted by a Geman-McClure kernel of scale `kernel_scale` (0: unweighted).
+  virtual NormalEquations linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) = 0;
+  // Sec. III-D: moves the model into the scan's frame and fuses the scan into it (frame-to-model), or
+  // makes the scan the model (frame-to-frame).
+  virtual void updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) = 0;
+  virtual void resetModel() = 0;
+
+  // Host views of the buffers, for tests, visualisation and backend comparison. A device backend
+  // copies its buffers to the host on these calls.
+  virtual const ScanImage& scan() = 0;
+  virtual const BevImage& scanGround() = 0;
+  virtual const Model& model() = 0;
+};
+
+// Makes the backend `config.runtime.backend` names. Throws std::runtime_error when it cannot run here
+// (a CUDA backend without a usable GPU, or a build without CUDA).
+std::unique_ptr<Backend> makeBackend(const Config& config);
+
+}  // namespace elo

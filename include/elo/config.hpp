@@ -1,0 +1,148 @@
+// Every parameter of the pipeline, with its default. This file is the one source of defaults: YAML files
+// and ROS parameters only override what is written here (see parameters() below), and the defaults are
+// the values of Zheng & Zhu, "Efficient LiDAR Odometry for Autonomous Driving", for an HDL-64E.
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace elo {
+
+// Which cost terms the registration uses (paper Table II); `fused` is the method, the others are the
+// ablations the paper compares against.
+enum class CostTerms { fused, spherical_all, spherical_nonground, bev_ground };
+// How normals of the spherical range image are computed (paper Table III).
+enum class NormalMethod { range_adaptive, eigen, cross_product };
+enum class RegistrationMode { frame_to_model, frame_to_frame };
+enum class MotionPrior { constant_acceleration, constant_velocity, none };
+enum class BackendKind { cpu, cuda };
+
+// Sec. III-B.1, Eq. 3-4: the sensor and its spherical range image.
+struct SensorConfig {
+  std::string name = "hdl64";
+  int image_width = 2048;          // w_S: azimuth columns
+  int image_height = 80;           // h_S: elevation rows
+  // The image spans a little more than the beams (+2 .. -24.33 deg), so that no beam sits on an image
+  // edge where half its points would fall out; +3 / -25 deg is KITTI's customary range image.
+  double fov_up_deg = 3.0;         // f_up: elevation of the top of the image
+  double fov_down_deg = -25.0;     // f_down: elevation of the bottom (negative: below the horizon)
+  double min_range = 2.5;          // closer returns hit the vehicle itself
+  double max_range = 120.0;
+  // Rotates every point's elevation up by this angle. KITTI's HDL-64E intrinsics bend the scan; the
+  // paper (after IMLS-SLAM) corrects by 0.195 deg. Zero for any other data.
+  double elevation_correction_deg = 0.0;
+  // Nominal elevation of each beam, top to bottom; the simulator fires these and the `ring` field of a
+  // driver indexes them. Empty means `beam_count` beams spread evenly over the field of view.
+  std::vector<double> beam_elevations_deg = hdl64BeamElevations();
+  int beam_count = 64;
+  int azimuth_steps = 2083;        // firings per revolution (simulator)
+  double rotation_rate_hz = 10.0;  // revolutions per second (simulator, per-point time)
+  double range_noise_stddev = 0.02;  // metres (simulator)
+
+  // The HDL-64E S2 table: an upper block of 32 lasers from +2 deg to -8.33 deg and a lower block of
+  // 32 from -8.83 deg to -24.33 deg (the field of view KITTI's scans show).
+  static std::vector<double> hdl64BeamElevations();
+};
+
+// Sec. III-C.1: ground segmentation on the columns of the range image.
+struct GroundConfig {
+  double sensor_height = 1.73;  // h_g: the sensor above the road, so the road lies at z = -h_g
+  double band_above = 0.5;      // delta_h1: a ground point lies below -h_g + band_above
+  double band_below = 1.0;      // delta_h2: ... and above -h_g - band_below
+  double max_slope_deg = 5.0;   // delta_theta: slope to the next valid pixel up and down the column
+};
+
+// Sec. III-B.3-4, Eq. 10-12: normals of the non-ground range image.
+struct NormalConfig {
+  NormalMethod method = NormalMethod::range_adaptive;
+  double search_size = 0.3;       // delta: metric extent of the neighbourhood window
+  int min_window_width = 5;       // l_x^min
+  int max_window_width = 13;      // l_x^max
+  int min_window_height = 3;      // l_y^min
+  int max_window_height = 7;      // l_y^max
+  double outlier_distance = 0.5;  // sigma_r: a neighbour farther than this from the centre is an outlier
+  double plane_distance = 0.5;    // sigma_z: point-to-plane distance that drops a neighbour at refit
+  int min_neighbours = 5;         // fewer inliers than this (the centre included) give no normal
+  // Curvature lambda3/(lambda1+lambda2+lambda3) above this is not planar; the paper selects planar
+  // points by curvature without giving the threshold.
+  double max_curvature = 0.1;
+};
+
+// Sec. III-C.2, Eq. 14-17: the bird's-eye-view map of ground points.
+struct BevConfig {
+  double cell_size = 0.1;     // s_x = s_y (m)
+  double half_length = 120.0; // w_B: the map spans x in [-w_B, w_B) around the sensor
+  double half_width = 60.0;   // h_B: ... and y in [-h_B, h_B)
+  int normal_neighbours = 5;  // model points fitted for the normal of a ground correspondence
+  int normal_patch_radius = 3;  // cells searched around the associated model cell
+};
+
+// Sec. III-A, Eq. 1-2: Gauss-Newton on SE(3) over w*E_S + (1-w)*E_G.
+struct RegistrationConfig {
+  CostTerms terms = CostTerms::fused;
+  double nonground_weight = 0.7;  // w1; w = w1 * w2 with w2 from the two inlier ratios
+  int max_iterations = 20;
+  double converged_translation = 1e-4;  // m: stop when the update is below both
+  double converged_rotation = 1e-5;     // rad
+  double max_correspondence_distance = 1.0;  // m between the moved scan point and its model point
+  double max_normal_angle_deg = 30.0;  // between a scan normal and its model normal
+  int association_radius = 1;  // pixels searched around the projection for the closest model vertex
+  // Scale (m) of the Geman-McClure kernel that down-weights large point-to-plane residuals (IRLS).
+  // Correspondences at edges and corners carry residuals of centimetres even at the true pose and would
+  // bias plain least squares; 0 gives the paper's plain least squares.
+  double robust_kernel_scale = 0.1;
+};
+
+// Sec. III-D: the model of three 2D maps.
+struct ModelConfig {
+  RegistrationMode mode = RegistrationMode::frame_to_model;
+  double time_window = 10.0;  // tau_w (s): older model points are dropped
+  MotionPrior motion_prior = MotionPrior::constant_acceleration;
+};
+
+struct RuntimeConfig {
+  BackendKind backend = BackendKind::cpu;
+  int threads = 0;  // 0: all hardware threads
+};
+
+struct Config {
+  SensorConfig sensor;
+  GroundConfig ground;
+  NormalConfig normals;
+  BevConfig bev;
+  RegistrationConfig registration;
+  ModelConfig model;
+  RuntimeConfig runtime;
+};
+
+// A parameter that YAML files, ROS parameters and command lines all set by the same dotted key
+// (`ground.max_slope_deg`). Choices (enums) travel as strings.
+using ParameterValue = std::variant<bool, int, double, std::string, std::vector<double>>;
+
+struct Parameter {
+  std::string key;
+  std::string description;
+  std::vector<std::string> choices;  // non-empty for enumerations
+  std::function<ParameterValue()> get;
+  std::function<void(const ParameterValue&)> set;  // throws ConfigError on a wrong type or choice
+};
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The table of every parameter of `config`, bound to its fields.
+std::vector<Parameter> parameters(Config& config);
+
+// Throws ConfigError naming the first parameter whose value cannot work (e.g. a zero image width).
+void validate(const Config& config);
+
+// Converts a value read as text (command line, YAML scalar) to the parameter's type and sets it.
+void setFromString(const Parameter& parameter, const std::string& text);
+std::string toString(const ParameterValue& value);
+
+}  // namespace elo

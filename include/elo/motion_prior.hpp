@@ -1,0 +1,28 @@
+// The initial guess of the registration (Sec. III-A): the motion of the last two increments
+// extrapolated at constant acceleration in the Lie algebra, scaled by the time since the last scan so
+// that dropped frames and irregular rates are predicted right.
+#pragma once
+
+#include "elo/config.hpp"
+#include "elo/se3.hpp"
+
+namespace elo {
+
+class MotionModel {
+ public:
+  explicit MotionModel(MotionPrior prior) : prior_(prior) {}
+
+  // The predicted T^{t-1}_t for a scan `dt` seconds after the previous one.
+  Eigen::Isometry3d predict(double dt) const;
+  // Records the estimated increment T^{t-1}_t that spanned `dt` seconds.
+  void record(const Eigen::Isometry3d& increment, double dt);
+  void reset() { history_ = 0; }
+
+ private:
+  MotionPrior prior_;
+  int history_ = 0;            // how many of the velocities below are known
+  Vector6d latest_velocity_;   // twist per second of the last increment
+  Vector6d previous_velocity_; // ... and of the one before
+};
+
+}  // namespace elo

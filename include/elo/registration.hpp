@@ -1,0 +1,38 @@
+// Gauss-Newton point-to-plane ICP on SE(3) over the fused cost w*E_S + (1-w)*E_G (Sec. III-A).
+#pragma once
+
+#include "elo/backend.hpp"
+
+namespace elo {
+
+struct RegistrationResult {
+  Eigen::Isometry3d model_from_scan = Eigen::Isometry3d::Identity();  // T^{t-1}_t
+  Matrix6d hessian = Matrix6d::Zero();  // the fused, normalised J^T J at the solution
+  int iterations = 0;
+  bool converged = false;
+  // No usable step: too few correspondences or a singular Hessian. model_from_scan then holds the last
+  // estimate that had one (the initial guess when the first iteration failed).
+  bool failed = false;
+  double weight = 0.0;  // w = w1 * w2 of the last iteration
+  NormalEquations last;  // the sums of the last iteration (inlier counts, errors)
+};
+
+// w = w1 * w2. w2 compares the inlier ratios of the two terms: 1 while non-ground matching is at least
+// as good as ground matching, and falling with the non-ground ratio when it is worse, so that w stays
+// in [0, w1] and the ground term takes over where the non-ground scene degrades (highway).
+double fusionWeight(const NormalEquations& sums, const RegistrationConfig& config);
+
+// Builds H = w/N_S sum J_S^T J_S + (1-w)/N_G sum J_G^T J_G and g likewise, each term normalised by its
+// inlier count so that w keeps its meaning whatever the point counts.
+void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H, Vector6d& g);
+
+// The kernel scale of an iteration: it starts at the correspondence gate, where the kernel barely
+// weighs anything, and halves each iteration down to `robust_kernel_scale`. A tight kernel from the
+// start would ignore the very residuals a poor initial guess produces; a tight kernel at the end keeps
+// edge correspondences from biasing the solution.
+double annealedKernelScale(int iteration, const RegistrationConfig& config);
+
+RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess,
+                                const RegistrationConfig& config);
+
+}  // namespace elo

@@ -1,0 +1,21 @@
+// SE(3) exponential and logarithm for the Gauss-Newton update T <- exp(delta) * T (Sec. III-A).
+// A twist is (rho, phi): translation part first, rotation part second, matching the Jacobian
+// n^T [I, -[p]x] of the point-to-plane residual.
+#pragma once
+
+#include <Eigen/Geometry>
+
+namespace elo {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+Eigen::Isometry3d expSE3(const Vector6d& twist);
+Vector6d logSE3(const Eigen::Isometry3d& transform);
+
+// Rotation angle (rad) and translation length (m) of a transform: the sizes convergence tests need.
+double rotationAngle(const Eigen::Isometry3d& transform);
+double translationNorm(const Eigen::Isometry3d& transform);
+
+}  // namespace elo

@@ -1,0 +1,80 @@
+// The data layout every backend shares: a scan as point arrays, and images as plain row-major arrays
+// (`rows x cols`, pixel index = row * cols + col). A CUDA backend mirrors these buffers one to one, so
+// any stage's output can be compared element by element across backends.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace elo {
+
+using Vec3f = Eigen::Vector3f;
+
+// One sweep of a spinning LiDAR in the sensor frame (x forward, y left, z up).
+struct PointCloud {
+  std::vector<Vec3f> points;
+  std::vector<float> intensity;  // empty, or one per point
+  std::vector<uint16_t> ring;    // empty, or the beam index of each point (0 = top beam)
+  std::vector<float> time;       // empty, or each point's time offset within the sweep (s)
+  double stamp = 0.0;            // acquisition time of the sweep (s)
+
+  size_t size() const { return points.size(); }
+};
+
+enum class PixelLabel : uint8_t { empty = 0, nonground = 1, ground = 2 };
+
+// A spherical range image of vertices with their normals: the scan's non-ground features and the
+// non-ground model share it. A pixel is empty when its range is 0; it has no normal when its normal
+// is the zero vector.
+struct SphericalImage {
+  int rows = 0;
+  int cols = 0;
+  std::vector<Vec3f> vertex;
+  std::vector<Vec3f> normal;
+  std::vector<float> range;
+  std::vector<float> stamp;  // when the vertex was observed (s since the first scan)
+
+  void resize(int image_rows, int image_cols);
+  void clear();  // all pixels empty, size kept
+  size_t pixelCount() const { return static_cast<size_t>(rows) * static_cast<size_t>(cols); }
+  bool occupied(size_t pixel) const { return range[pixel] > 0.0f; }
+  bool hasNormal(size_t pixel) const { return !normal[pixel].isZero(); }
+  size_t countOccupied() const;
+};
+
+// The scan after projection: which cloud point each pixel holds and its label.
+struct ScanImage {
+  SphericalImage image;           // every projected point; normals only on non-ground pixels
+  std::vector<int32_t> point_index;  // cloud index per pixel, -1 when empty
+  std::vector<PixelLabel> label;
+
+  void resize(int rows, int cols);
+  void clear();
+};
+
+// A bird's-eye-view map of ground points (Eq. 14): cell (u, v) holds one vertex. Occupied cells are
+// also listed, so that clearing and iterating cost the number of points, not the size of the grid.
+struct BevImage {
+  int rows = 0;  // along y
+  int cols = 0;  // along x
+  std::vector<Vec3f> vertex;
+  std::vector<float> range;  // distance to the sensor, 0 = empty cell
+  std::vector<float> stamp;
+  std::vector<int32_t> occupied_cells;
+
+  void resize(int image_rows, int image_cols);
+  void clear();
+  size_t cellCount() const { return static_cast<size_t>(rows) * static_cast<size_t>(cols); }
+  bool occupied(size_t cell) const { return range[cell] > 0.0f; }
+};
+
+// The local map, in the frame of the latest scan (Sec. III-D): the non-ground vertex and normal maps
+// and the ground BEV vertex map.
+struct Model {
+  SphericalImage nonground;
+  BevImage ground;
+  bool initialized = false;
+};
+
+}  // namespace elo

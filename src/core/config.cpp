@@ -1,0 +1,286 @@
+#include "elo/config.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <type_traits>
+#include <utility>
+
+namespace elo {
+
+std::vector<double> SensorConfig::hdl64BeamElevations() {
+  std::vector<double> elevations;
+  constexpr int kBeamsPerBlock = 32;
+  const auto add_block = [&](double top, double bottom) {
+    for (int i = 0; i < kBeamsPerBlock; ++i) {
+      elevations.push_back(top + (bottom - top) * i / (kBeamsPerBlock - 1));
+    }
+  };
+  add_block(2.0, -8.33);
+  add_block(-8.83, -24.33);
+  return elevations;
+}
+
+namespace {
+
+template <typename T>
+const char* typeName() {
+  if constexpr (std::is_same_v<T, bool>) return "a boolean";
+  if constexpr (std::is_same_v<T, int>) return "an integer";
+  if constexpr (std::is_same_v<T, double>) return "a number";
+  if constexpr (std::is_same_v<T, std::string>) return "a string";
+  if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
+}
+
+// Reads `value` as a T, widening int to double, or throws naming the parameter.
+template <typename T>
+T convert(const std::string& key, const ParameterValue& value) {
+  if (const T* exact = std::get_if<T>(&value)) return *exact;
+  if constexpr (std::is_same_v<T, double>) {
+    if (const int* integer = std::get_if<int>(&value)) return *integer;
+  }
+  if constexpr (std::is_same_v<T, std::vector<double>>) {
+    if (const double* single = std::get_if<double>(&value)) return {*single};
+  }
+  throw ConfigError("parameter '" + key + "' expects " + typeName<T>() + ", got '" + toString(value) + "'");
+}
+
+template <typename T>
+Parameter bindField(std::string key, T& field, std::string description) {
+  Parameter parameter;
+  parameter.key = key;
+  parameter.description = std::move(description);
+  parameter.get = [&field] { return ParameterValue(field); };
+  parameter.set = [&field, key](const ParameterValue& value) { field = convert<T>(key, value); };
+  return parameter;
+}
+
+template <typename Enum>
+Parameter bindChoice(std::string key, Enum& field, std::vector<std::pair<Enum, std::string>> names,
+                     std::string description) {
+  Parameter parameter;
+  parameter.key = key;
+  parameter.description = std::move(description);
+  for (const auto& name : names) parameter.choices.push_back(name.second);
+  parameter.get = [&field, names] {
+    for (const auto& [value, name] : names) {
+      if (value == field) return ParameterValue(name);
+    }
+    return ParameterValue(std::string("?"));
+  };
+  parameter.set = [&field, names, key](const ParameterValue& value) {
+    const std::string text = convert<std::string>(key, value);
+    for (const auto& [choice, name] : names) {
+      if (name == text) {
+        field = choice;
+        return;
+      }
+    }
+    std::string known;
+    for (const auto& name : names) known += (known.empty() ? "" : "|") + name.second;
+    throw ConfigError("parameter '" + key + "' must be one of " + known + ", got '" + text + "'");
+  };
+  return parameter;
+}
+
+void require(bool condition, const std::string& key, const std::string& requirement) {
+  if (!condition) throw ConfigError("parameter '" + key + "' " + requirement);
+}
+
+bool isOdd(int value) { return value > 0 && value % 2 == 1; }
+
+}  // namespace
+
+std::vector<Parameter> parameters(Config& c) {
+  SensorConfig& s = c.sensor;
+  GroundConfig& g = c.ground;
+  NormalConfig& n = c.normals;
+  BevConfig& b = c.bev;
+  RegistrationConfig& r = c.registration;
+  ModelConfig& m = c.model;
+  return {
+      bindField("sensor.name", s.name, "sensor model name (informative)"),
+      bindField("sensor.image_width", s.image_width, "w_S: columns of the spherical range image (Sec. III-B.1)"),
+      bindField("sensor.image_height", s.image_height, "h_S: rows of the spherical range image (Sec. III-B.1)"),
+      bindField("sensor.fov_up_deg", s.fov_up_deg, "f_up: elevation of the image top, deg (Eq. 4)"),
+      bindField("sensor.fov_down_deg", s.fov_down_deg, "f_down: elevation of the image bottom, deg, negative (Eq. 4)"),
+      bindField("sensor.min_range", s.min_range, "returns closer than this (m) are dropped"),
+      bindField("sensor.max_range", s.max_range, "returns farther than this (m) are dropped"),
+      bindField("sensor.elevation_correction_deg", s.elevation_correction_deg,
+           "raise every point's elevation by this angle; 0.195 for KITTI (Sec. IV-A)"),
+      bindField("sensor.beam_elevations_deg", s.beam_elevations_deg,
+           "nominal beam elevations top to bottom, deg; empty = beam_count beams spread evenly"),
+      bindField("sensor.beam_count", s.beam_count, "number of beams"),
+      bindField("sensor.azimuth_steps", s.azimuth_steps, "firings per revolution (simulator)"),
+      bindField("sensor.rotation_rate_hz", s.rotation_rate_hz, "revolutions per second (simulator)"),
+      bindField("sensor.range_noise_stddev", s.range_noise_stddev, "range noise, m (simulator)"),
+      bindField("ground.sensor_height", g.sensor_height, "h_g: sensor height above the road, m (Sec. III-C.1)"),
+      bindField("ground.band_above", g.band_above, "delta_h1: ground band above the road height, m (Sec. III-C.1)"),
+      bindField("ground.band_below", g.band_below, "delta_h2: ground band below the road height, m (Sec. III-C.1)"),
+      bindField("ground.max_slope_deg", g.max_slope_deg, "delta_theta: slope limit between column neighbours, deg (Eq. 13)"),
+      bindChoice("normals.method", n.method,
+                 {{NormalMethod::range_adaptive, "range_adaptive"},
+                  {NormalMethod::eigen, "eigen"},
+                  {NormalMethod::cross_product, "cross_product"}},
+                 "normal estimator (Table III); eigen = fixed largest window without outlier tests"),
+      bindField("normals.search_size", n.search_size, "delta: metric window size, m (Eq. 12)"),
+      bindField("normals.min_window_width", n.min_window_width, "l_x^min, pixels, odd (Eq. 12)"),
+      bindField("normals.max_window_width", n.max_window_width, "l_x^max, pixels, odd (Eq. 12)"),
+      bindField("normals.min_window_height", n.min_window_height, "l_y^min, pixels, odd (Eq. 12)"),
+      bindField("normals.max_window_height", n.max_window_height, "l_y^max, pixels, odd (Eq. 12)"),
+      bindField("normals.outlier_distance", n.outlier_distance, "sigma_r: neighbour distance test, m (Sec. III-B.4)"),
+      bindField("normals.plane_distance", n.plane_distance, "sigma_z: point-to-plane test at refit, m (Sec. III-B.4)"),
+      bindField("normals.min_neighbours", n.min_neighbours, "fewest inlier points for a normal"),
+      bindField("normals.max_curvature", n.max_curvature, "planar point selection by curvature (Eq. 11)"),
+      bindField("bev.cell_size", b.cell_size, "s: BEV cell size, m (Eq. 14)"),
+      bindField("bev.half_length", b.half_length, "w_B: BEV half extent along x, m (Eq. 14)"),
+      bindField("bev.half_width", b.half_width, "h_B: BEV half extent along y, m (Eq. 14)"),
+      bindField("bev.normal_neighbours", b.normal_neighbours, "model points fitted for a ground normal (Sec. III-C.2)"),
+      bindField("bev.normal_patch_radius", b.normal_patch_radius, "cells searched for them around the association"),
+      bindChoice("registration.terms", r.terms,
+                 {{CostTerms::fused, "fused"},
+                  {CostTerms::spherical_all, "spherical_all"},
+                  {CostTerms::spherical_nonground, "spherical_nonground"},
+                  {CostTerms::bev_ground, "bev_ground"}},
+                 "cost terms (Table II): fused SRI+BEV, or one projection alone"),
+      bindField("registration.nonground_weight", r.nonground_weight, "w1 of w = w1*w2 (Eq. 1)"),
+      bindField("registration.max_iterations", r.max_iterations, "Gauss-Newton iteration limit"),
+      bindField("registration.converged_translation", r.converged_translation, "stop when the update moves less, m"),
+      bindField("registration.converged_rotation", r.converged_rotation, "... and turns less, rad"),
+      bindField("registration.max_correspondence_distance", r.max_correspondence_distance,
+           "gate on the distance between a moved scan point and its model point, m"),
+      bindField("registration.max_normal_angle_deg", r.max_normal_angle_deg, "gate on the scan/model normal angle, deg"),
+      bindField("registration.association_radius", r.association_radius,
+           "pixels searched around the projective association"),
+      bindField("registration.robust_kernel_scale", r.robust_kernel_scale,
+                "Geman-McClure scale for point-to-plane residuals, m; 0 = plain least squares"),
+      bindChoice("model.mode", m.mode,
+                 {{RegistrationMode::frame_to_model, "frame_to_model"},
+                  {RegistrationMode::frame_to_frame, "frame_to_frame"}},
+                 "register against the fused model or the previous scan (Sec. III-D)"),
+      bindField("model.time_window", m.time_window, "tau_w: model points older than this are dropped, s (Sec. III-D)"),
+      bindChoice("model.motion_prior", m.motion_prior,
+                 {{MotionPrior::constant_acceleration, "constant_acceleration"},
+                  {MotionPrior::constant_velocity, "constant_velocity"},
+                  {MotionPrior::none, "none"}},
+                 "initial guess of the registration (Sec. III-A)"),
+      bindChoice("runtime.backend", c.runtime.backend,
+                 {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
+      bindField("runtime.threads", c.runtime.threads, "CPU threads, 0 = all"),
+  };
+}
+
+void validate(const Config& c) {
+  const SensorConfig& s = c.sensor;
+  require(s.image_width > 0, "sensor.image_width", "must be positive");
+  require(s.image_height > 0, "sensor.image_height", "must be positive");
+  require(s.fov_up_deg > s.fov_down_deg, "sensor.fov_up_deg", "must be above sensor.fov_down_deg");
+  require(s.fov_up_deg <= 90.0 && s.fov_down_deg >= -90.0, "sensor.fov_up_deg", "and fov_down_deg must lie in [-90, 90]");
+  require(s.min_range >= 0.0, "sensor.min_range", "must not be negative");
+  require(s.max_range > s.min_range, "sensor.max_range", "must exceed sensor.min_range");
+  require(std::abs(s.elevation_correction_deg) < 5.0, "sensor.elevation_correction_deg", "must be under 5 deg");
+  require(s.beam_count > 0, "sensor.beam_count", "must be positive");
+  require(s.beam_elevations_deg.empty() || static_cast<int>(s.beam_elevations_deg.size()) == s.beam_count,
+          "sensor.beam_elevations_deg", "must list sensor.beam_count elevations (or none)");
+  require(s.azimuth_steps > 0, "sensor.azimuth_steps", "must be positive");
+  require(s.rotation_rate_hz > 0.0, "sensor.rotation_rate_hz", "must be positive");
+  require(s.range_noise_stddev >= 0.0, "sensor.range_noise_stddev", "must not be negative");
+
+  const GroundConfig& g = c.ground;
+  require(g.sensor_height > 0.0, "ground.sensor_height", "must be positive");
+  require(g.band_above > 0.0, "ground.band_above", "must be positive");
+  require(g.band_below > 0.0, "ground.band_below", "must be positive");
+  require(g.max_slope_deg > 0.0 && g.max_slope_deg < 90.0, "ground.max_slope_deg", "must lie in (0, 90)");
+
+  const NormalConfig& n = c.normals;
+  require(n.search_size > 0.0, "normals.search_size", "must be positive");
+  require(isOdd(n.min_window_width), "normals.min_window_width", "must be a positive odd number");
+  require(isOdd(n.max_window_width) && n.max_window_width >= n.min_window_width, "normals.max_window_width",
+          "must be odd and at least normals.min_window_width");
+  require(isOdd(n.min_window_height), "normals.min_window_height", "must be a positive odd number");
+  require(isOdd(n.max_window_height) && n.max_window_height >= n.min_window_height, "normals.max_window_height",
+          "must be odd and at least normals.min_window_height");
+  require(n.outlier_distance > 0.0, "normals.outlier_distance", "must be positive");
+  require(n.plane_distance > 0.0, "normals.plane_distance", "must be positive");
+  require(n.min_neighbours >= 3, "normals.min_neighbours", "must be at least 3 (a plane needs three points)");
+  require(n.max_curvature > 0.0 && n.max_curvature <= 1.0 / 3.0, "normals.max_curvature", "must lie in (0, 1/3]");
+
+  const BevConfig& b = c.bev;
+  require(b.cell_size > 0.0, "bev.cell_size", "must be positive");
+  require(b.half_length > 0.0, "bev.half_length", "must be positive");
+  require(b.half_width > 0.0, "bev.half_width", "must be positive");
+  const double cells = (2.0 * b.half_length / b.cell_size) * (2.0 * b.half_width / b.cell_size);
+  require(cells <= 1e8, "bev.cell_size", "gives more than 1e8 BEV cells: enlarge it or shrink the extents");
+  require(b.normal_neighbours >= 3, "bev.normal_neighbours", "must be at least 3");
+  require(b.normal_patch_radius >= 1, "bev.normal_patch_radius", "must be at least 1");
+
+  const RegistrationConfig& r = c.registration;
+  require(r.nonground_weight >= 0.0 && r.nonground_weight <= 1.0, "registration.nonground_weight", "must lie in [0, 1]");
+  require(r.max_iterations >= 1, "registration.max_iterations", "must be at least 1");
+  require(r.converged_translation > 0.0, "registration.converged_translation", "must be positive");
+  require(r.converged_rotation > 0.0, "registration.converged_rotation", "must be positive");
+  require(r.max_correspondence_distance > 0.0, "registration.max_correspondence_distance", "must be positive");
+  require(r.max_normal_angle_deg > 0.0 && r.max_normal_angle_deg <= 180.0, "registration.max_normal_angle_deg",
+          "must lie in (0, 180]");
+  require(r.association_radius >= 0, "registration.association_radius", "must not be negative");
+  require(r.robust_kernel_scale >= 0.0, "registration.robust_kernel_scale", "must not be negative");
+
+  require(c.model.time_window > 0.0, "model.time_window", "must be positive");
+  require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
+}
+
+void setFromString(const Parameter& parameter, const std::string& text) {
+  const ParameterValue current = parameter.get();
+  std::istringstream stream(text);
+  ParameterValue value;
+  const auto fail = [&] {
+    throw ConfigError("parameter '" + parameter.key + "' cannot be set from '" + text + "'");
+  };
+  if (std::holds_alternative<bool>(current)) {
+    if (text == "true" || text == "1") value = true;
+    else if (text == "false" || text == "0") value = false;
+    else fail();
+  } else if (std::holds_alternative<int>(current)) {
+    int number = 0;
+    if (!(stream >> number) || !stream.eof()) fail();
+    value = number;
+  } else if (std::holds_alternative<double>(current)) {
+    double number = 0.0;
+    if (!(stream >> number) || !stream.eof()) fail();
+    value = number;
+  } else if (std::holds_alternative<std::vector<double>>(current)) {
+    std::vector<double> numbers;
+    std::string item;
+    while (std::getline(stream, item, ',')) {
+      std::istringstream item_stream(item);
+      double number = 0.0;
+      if (!(item_stream >> number)) fail();
+      numbers.push_back(number);
+    }
+    value = numbers;
+  } else {
+    value = text;
+  }
+  parameter.set(value);
+}
+
+std::string toString(const ParameterValue& value) {
+  std::ostringstream out;
+  out.precision(10);
+  std::visit(
+      [&out](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          out << (v ? "true" : "false");
+        } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+          out << '[';
+          for (size_t i = 0; i < v.size(); ++i) out << (i ? ", " : "") << v[i];
+          out << ']';
+        } else {
+          out << v;
+        }
+      },
+      value);
+  return out.str();
+}
+
+}  // namespace elo

@@ -1,0 +1,94 @@
+#include "core/cpu/cpu_backend.hpp"
+
+#include <utility>
+
+namespace elo::cpu {
+
+namespace {
+
+int arenaThreads(int requested) { return requested > 0 ? requested : tbb::task_arena::automatic; }
+
+void allocate(Model& model, const SphericalProjection& spherical, const BevProjection& bev) {
+  model.nonground.resize(spherical.rows, spherical.cols);
+  model.ground.resize(bev.rows, bev.cols);
+  model.initialized = false;
+}
+
+}  // namespace
+
+CpuBackend::CpuBackend(const Config& config)
+    : config_(config),
+      spherical_(SphericalProjection::fromConfig(config.sensor)),
+      bev_(BevProjection::fromConfig(config.bev)),
+      arena_(arenaThreads(config.runtime.threads)) {
+  for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  scan_.resize(spherical_.rows, spherical_.cols);
+  scan_ground_.resize(bev_.rows, bev_.cols);
+  allocate(model_, spherical_, bev_);
+  allocate(fused_, spherical_, bev_);
+  winners_.resize(scan_.image.pixelCount());
+  ground_normals_.resize(model_.ground.cellCount());
+}
+
+size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp) {
+  size_t occupied = 0;
+  arena_.execute([&] { occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, stamp, winners_, scan_); });
+  return occupied;
+}
+
+void CpuBackend::segmentGround() {
+  arena_.execute([&] {
+    if (config_.registration.terms == CostTerms::spherical_all) {
+      labelAllNonground(scan_);
+    } else {
+      cpu::segmentGround(config_.ground, scan_);
+    }
+  });
+}
+
+void CpuBackend::estimateNormals() {
+  arena_.execute([&] { cpu::estimateNormals(config_.normals, spherical_, scan_); });
+}
+
+void CpuBackend::buildGroundMap() { cpu::buildGroundMap(scan_, bev_, scan_ground_); }
+
+NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+  NormalEquations sums;
+  const CostTerms terms = config_.registration.terms;
+  arena_.execute([&] {
+    if (terms != CostTerms::bev_ground) {
+      sums.nonground = nongroundSums(scan_, model_.nonground, spherical_, model_from_scan, kernel_scale,
+                                     config_.registration);
+    }
+    if (terms == CostTerms::fused || terms == CostTerms::bev_ground) {
+      sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,
+                               config_.registration, config_.bev);
+    }
+  });
+  return sums;
+}
+
+void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) {
+  ground_normals_.invalidate(model_.ground);
+  if (!model_.initialized || config_.model.mode == RegistrationMode::frame_to_frame) {
+    arena_.execute([&] { copyScanToModel(scan_, scan_ground_, model_); });
+    return;
+  }
+  const float window = static_cast<float>(config_.model.time_window);
+  arena_.execute([&] {
+    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, stamp, window, winners_,
+                       fused_.nonground);
+  });
+  fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, stamp, window, fused_.ground);
+  std::swap(model_, fused_);
+  model_.initialized = true;
+}
+
+void CpuBackend::resetModel() {
+  ground_normals_.invalidate(model_.ground);
+  model_.nonground.clear();
+  model_.ground.clear();
+  model_.initialized = false;
+}
+
+}  // namespace elo::cpu

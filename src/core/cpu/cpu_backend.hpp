@@ -1,0 +1,42 @@
+// The threaded CPU implementation of the backend interface.
+#pragma once
+
+#include <tbb/task_arena.h>
+
+#include "core/cpu/stages.hpp"
+
+namespace elo::cpu {
+
+class CpuBackend final : public Backend {
+ public:
+  explicit CpuBackend(const Config& config);
+
+  const char* name() const override { return "cpu"; }
+  size_t projectScan(const PointCloud& cloud, float stamp) override;
+  void segmentGround() override;
+  void estimateNormals() override;
+  void buildGroundMap() override;
+  NormalEquations linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) override;
+  void updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) override;
+  void resetModel() override;
+
+  const ScanImage& scan() override { return scan_; }
+  const BevImage& scanGround() override { return scan_ground_; }
+  const Model& model() override { return model_; }
+
+ private:
+  Config config_;
+  SphericalProjection spherical_;
+  BevProjection bev_;
+  std::vector<int> ring_rows_;
+  tbb::task_arena arena_;
+
+  ScanImage scan_;
+  BevImage scan_ground_;
+  Model model_;
+  Model fused_;  // the model update writes here, then swaps with model_
+  ClosestWins winners_;
+  GroundNormalCache ground_normals_;
+};
+
+}  // namespace elo::cpu

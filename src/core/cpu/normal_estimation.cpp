@@ -1,0 +1,170 @@
+// Sec. III-B.3-4: normals of the non-ground range image. The range-adaptive estimator sizes its window
+// from the metric extent delta at the point's range (Eq. 12), rejects the point when most neighbours are
+// far from it (sigma_r), fits a plane by eigen-decomposition, drops neighbours far from that plane
+// (sigma_z) and refits; curvature then selects planar points (Eq. 11). The eigen and cross-product
+// estimators are the baselines of Table III.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/cpu/parallel.hpp"
+#include "core/cpu/plane_fit.hpp"
+#include "core/cpu/stages.hpp"
+
+namespace elo::cpu {
+
+namespace {
+
+// The odd window size nearest to `pixels`, clamped: odd keeps the window centred on its pixel.
+int oddWindow(double pixels, int smallest, int largest) {
+  const int odd = 2 * static_cast<int>(std::floor(std::max(pixels, 0.0) / 2.0)) + 1;
+  return std::clamp(odd, smallest, largest);
+}
+
+struct Window {
+  int half_width;
+  int half_height;
+};
+
+}  // namespace
+
+WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range) {
+  const double width = config.search_size / (range * M_PI) * projection.cols;
+  const double height = config.search_size / (range * projection.fov_span) * projection.rows;
+  return {oddWindow(width, config.min_window_width, config.max_window_width),
+          oddWindow(height, config.min_window_height, config.max_window_height)};
+}
+
+namespace {
+
+class NormalEstimator {
+ public:
+  NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan)
+      : config_(config), projection_(projection), scan_(scan), image_(scan.image) {}
+
+  void estimate(size_t pixel, std::vector<Vec3f>& neighbours) const {
+    if (scan_.label[pixel] != PixelLabel::nonground) return;
+    if (config_.method == NormalMethod::cross_product) {
+      image_.normal[pixel] = crossProductNormal(pixel);
+      return;
+    }
+    gatherNeighbours(pixel, windowOf(pixel), neighbours);
+    const Vec3f& centre = image_.vertex[pixel];
+    if (config_.method == NormalMethod::range_adaptive && !rejectDistantNeighbours(centre, neighbours)) return;
+    neighbours.push_back(centre);
+    PlaneFit fit = fitEnough(neighbours, centre);
+    if (!fit.valid) return;
+    if (config_.method == NormalMethod::range_adaptive && dropOffPlane(centre, fit.normal, neighbours)) {
+      fit = fitEnough(neighbours, centre);
+      if (!fit.valid) return;
+    }
+    if (fit.curvature > config_.max_curvature) return;
+    image_.normal[pixel] = towardsSensor(fit.normal, centre);
+  }
+
+ private:
+  Window windowOf(size_t pixel) const {
+    if (config_.method == NormalMethod::eigen) {
+      return {config_.max_window_width / 2, config_.max_window_height / 2};
+    }
+    const WindowSize size = rangeAdaptiveWindow(config_, projection_, image_.range[pixel]);
+    return {size.width / 2, size.height / 2};
+  }
+
+  bool usable(int row, int col) const {
+    return row >= 0 && row < projection_.rows && scan_.label[index(row, col)] == PixelLabel::nonground;
+  }
+  size_t index(int row, int col) const {
+    const int wrapped = (col % projection_.cols + projection_.cols) % projection_.cols;  // azimuth is circular
+    return static_cast<size_t>(row) * projection_.cols + wrapped;
+  }
+
+  void gatherNeighbours(size_t pixel, const Window& window, std::vector<Vec3f>& neighbours) const {
+    neighbours.clear();
+    const int row = static_cast<int>(pixel) / projection_.cols;
+    const int col = static_cast<int>(pixel) % projection_.cols;
+    for (int r = row - window.half_height; r <= row + window.half_height; ++r) {
+      for (int c = col - window.half_width; c <= col + window.half_width; ++c) {
+        if ((r == row && c == col) || !usable(r, c)) continue;
+        neighbours.push_back(image_.vertex[index(r, c)]);
+      }
+    }
+  }
+
+  // Test 1: the point is an outlier when more than half its neighbours lie farther than sigma_r;
+  // otherwise those far neighbours leave the fit. Returns false for an outlier.
+  bool rejectDistantNeighbours(const Vec3f& centre, std::vector<Vec3f>& neighbours) const {
+    const float limit = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
+    const size_t total = neighbours.size();
+    const auto far = std::remove_if(neighbours.begin(), neighbours.end(),
+                                    [&](const Vec3f& q) { return (q - centre).squaredNorm() > limit; });
+    const size_t far_count = static_cast<size_t>(neighbours.end() - far);
+    neighbours.erase(far, neighbours.end());
+    return 2 * far_count <= total;
+  }
+
+  // Test 2: neighbours farther than sigma_z from the plane through the centre leave the fit.
+  // Returns whether any left.
+  bool dropOffPlane(const Vec3f& centre, const Vec3f& normal, std::vector<Vec3f>& neighbours) const {
+    const float limit = static_cast<float>(config_.plane_distance);
+    const size_t before = neighbours.size();
+    neighbours.erase(std::remove_if(neighbours.begin(), neighbours.end(),
+                                    [&](const Vec3f& q) { return std::abs((q - centre).dot(normal)) > limit; }),
+                     neighbours.end());
+    return neighbours.size() != before;
+  }
+
+  PlaneFit fitEnough(const std::vector<Vec3f>& points, const Vec3f& centre) const {
+    if (static_cast<int>(points.size()) < config_.min_neighbours) return {};
+    return fitPlane(points.data(), static_cast<int>(points.size()), centre);
+  }
+
+  // The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away.
+  const Vec3f* nearestAlong(int row, int col, int row_step, int col_step) const {
+    for (int step = 1; step <= 2; ++step) {
+      const int r = row + step * row_step;
+      const int c = col + step * col_step;
+      if (usable(r, c)) return &image_.vertex[index(r, c)];
+    }
+    return nullptr;
+  }
+
+  Vec3f crossProductNormal(size_t pixel) const {
+    const int row = static_cast<int>(pixel) / projection_.cols;
+    const int col = static_cast<int>(pixel) % projection_.cols;
+    const Vec3f* left = nearestAlong(row, col, 0, -1);
+    const Vec3f* right = nearestAlong(row, col, 0, 1);
+    const Vec3f* up = nearestAlong(row, col, -1, 0);
+    const Vec3f* down = nearestAlong(row, col, 1, 0);
+    if (!left || !right || !up || !down) return Vec3f::Zero();
+    const Vec3f normal = (*right - *left).cross(*down - *up);
+    const float length = normal.norm();
+    if (!(length > 0.0f)) return Vec3f::Zero();
+    return towardsSensor(normal / length, image_.vertex[pixel]);
+  }
+
+  static Vec3f towardsSensor(const Vec3f& normal, const Vec3f& point) {
+    return normal.dot(point) > 0.0f ? Vec3f(-normal) : normal;
+  }
+
+  const NormalConfig& config_;
+  const SphericalProjection& projection_;
+  ScanImage& scan_;
+  SphericalImage& image_;
+};
+
+}  // namespace
+
+void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan) {
+  const NormalEstimator estimator(config, projection, scan);
+  const size_t capacity = static_cast<size_t>(config.max_window_width) * config.max_window_height;
+  const size_t pixels = scan.image.pixelCount();
+  constexpr size_t kChunk = 1024;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, kChunk), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<Vec3f> neighbours;  // reused across the chunk: no allocation per pixel
+    neighbours.reserve(capacity);
+    for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) estimator.estimate(pixel, neighbours);
+  });
+}
+
+}  // namespace elo::cpu

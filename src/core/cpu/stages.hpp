@@ -1,0 +1,73 @@
+// The per-frame stages of the CPU backend as free functions, one file each, so that each can be tested
+// on its own. They parallelise with TBB inside whatever task arena calls them.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <atomic>
+#include <memory>
+
+#include "core/cpu/closest_wins.hpp"
+#include "elo/backend.hpp"
+#include "elo/sensor_model.hpp"
+
+namespace elo::cpu {
+
+// projection.cpp: the closest point of the cloud per pixel; `ring_rows` maps a driver's ring index to
+// its row (empty: rows from the elevation). Returns the number of occupied pixels.
+size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
+                    const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan);
+
+// ground_segmentation.cpp: labels occupied pixels ground or non-ground, column by column.
+void segmentGround(const GroundConfig& config, ScanImage& scan);
+// Every occupied pixel non-ground (the "spherical, all points" variant of Table II).
+void labelAllNonground(ScanImage& scan);
+
+// normal_estimation.cpp: normals of the non-ground pixels by the configured method.
+struct WindowSize {
+  int width;   // l_x, pixels, odd
+  int height;  // l_y, pixels, odd
+};
+// The range-adaptive window of Eq. 12 for a point at `range`.
+WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range);
+void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan);
+
+// bev_map.cpp: the BEV map of the ground pixels, closest point per cell.
+void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground);
+// Writes `vertex` into `map` unless the cell already holds a point closer to the sensor.
+void keepCloserGroundPoint(BevImage& map, int32_t cell, const Vec3f& vertex, float stamp);
+
+// Normals of the BEV model, fitted on demand to the model points nearest each associated cell
+// (Sec. III-C.2) and kept until the model changes. Safe to query from many threads: a cell is fitted
+// from the model alone, so whichever thread fits it first stores the same value any other would.
+class GroundNormalCache {
+ public:
+  void resize(size_t cells);
+  // Forgets the cells of `model` (call before the model changes).
+  void invalidate(const BevImage& model);
+  Vec3f normal(const BevImage& model, const BevProjection& projection, const BevConfig& config, int32_t cell);
+
+ private:
+  enum State : uint8_t { unknown = 0, fitting = 1, fitted = 2 };
+  std::vector<Vec3f> normals_;
+  std::unique_ptr<std::atomic<uint8_t>[]> states_;
+};
+
+// correspondences.cpp: the Gauss-Newton sums of each cost term for the scan moved by `model_from_scan`.
+TermSums nongroundSums(const ScanImage& scan, const SphericalImage& model, const SphericalProjection& projection,
+                       const Eigen::Isometry3d& model_from_scan, double kernel_scale,
+                       const RegistrationConfig& config);
+TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const BevProjection& projection,
+                    GroundNormalCache& normals, const Eigen::Isometry3d& model_from_scan, double kernel_scale,
+                    const RegistrationConfig& registration, const BevConfig& bev);
+
+// model_update.cpp: moves the model into the scan's frame and fuses the scan into it, closest point
+// winning, dropping model points older than `time_window`. Results go to `fused`.
+void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
+                        const Eigen::Isometry3d& model_from_scan, float stamp, float time_window,
+                        ClosestWins& winners, SphericalImage& fused);
+void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
+                     const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused);
+// Frame-to-frame: the model becomes the scan's non-ground features and ground map.
+void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
+
+}  // namespace elo::cpu

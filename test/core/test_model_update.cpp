@@ -1,0 +1,142 @@
+// The model update of Sec. III-D: closer point wins, empty pixels keep the model, old points expire.
+#include <gtest/gtest.h>
+
+#include "core/cpu/stages.hpp"
+
+namespace elo {
+namespace {
+
+struct Fixture {
+  Config config;
+  SphericalProjection spherical = SphericalProjection::fromConfig(config.sensor);
+  BevProjection bev = BevProjection::fromConfig(config.bev);
+  cpu::ClosestWins winners;
+
+  Fixture() { winners.resize(static_cast<size_t>(spherical.rows) * spherical.cols); }
+
+  size_t pixelOf(const Vec3f& p) const {
+    int row = 0;
+    int col = 0;
+    EXPECT_TRUE(spherical.pixelOf(p, row, col));
+    return static_cast<size_t>(row) * spherical.cols + col;
+  }
+  static void put(SphericalImage& image, size_t pixel, const Vec3f& p, float stamp) {
+    image.vertex[pixel] = p;
+    image.range[pixel] = p.norm();
+    image.normal[pixel] = -p.normalized();
+    image.stamp[pixel] = stamp;
+  }
+};
+
+TEST(ModelUpdate, CloserPointWinsAndEmptyScanPixelsKeepTheModel) {
+  Fixture f;
+  SphericalImage model;
+  model.resize(f.spherical.rows, f.spherical.cols);
+  ScanImage scan;
+  scan.resize(f.spherical.rows, f.spherical.cols);
+  SphericalImage fused;
+  fused.resize(f.spherical.rows, f.spherical.cols);
+
+  const Vec3f direction_a = Vec3f(1.0f, 0.1f, -0.05f).normalized();
+  const Vec3f direction_b = Vec3f(0.2f, 1.0f, -0.05f).normalized();
+  const Vec3f direction_c = Vec3f(-1.0f, 0.3f, -0.02f).normalized();
+  const size_t a = f.pixelOf(direction_a * 20.0f);
+  const size_t b = f.pixelOf(direction_b * 8.0f);
+  const size_t c = f.pixelOf(direction_c * 15.0f);
+  Fixture::put(model, a, direction_a * 20.0f, 0.0f);  // scan sees something closer here
+  Fixture::put(model, b, direction_b * 8.0f, 0.0f);   // the model is closer here
+  Fixture::put(model, c, direction_c * 15.0f, 0.0f);  // the scan sees nothing here
+  for (const auto& [pixel, point] : {std::pair{a, direction_a * 12.0f}, std::pair{b, direction_b * 30.0f}}) {
+    Fixture::put(scan.image, pixel, point, 1.0f);
+    scan.label[pixel] = PixelLabel::nonground;
+  }
+
+  cpu::fuseSphericalModel(model, scan, f.spherical, Eigen::Isometry3d::Identity(), 1.0f, 10.0f, f.winners, fused);
+  EXPECT_FLOAT_EQ(fused.range[a], 12.0f);
+  EXPECT_FLOAT_EQ(fused.stamp[a], 1.0f);
+  EXPECT_FLOAT_EQ(fused.range[b], 8.0f);
+  EXPECT_FLOAT_EQ(fused.stamp[b], 0.0f);
+  EXPECT_FLOAT_EQ(fused.range[c], 15.0f);
+  EXPECT_EQ(fused.countOccupied(), 3u);
+}
+
+TEST(ModelUpdate, ModelPointsMoveIntoTheNewFrameAndExpire) {
+  Fixture f;
+  SphericalImage model;
+  model.resize(f.spherical.rows, f.spherical.cols);
+  ScanImage scan;
+  scan.resize(f.spherical.rows, f.spherical.cols);
+  SphericalImage fused;
+  fused.resize(f.spherical.rows, f.spherical.cols);
+  const Vec3f fresh(20.0f, 2.0f, 0.5f);
+  const Vec3f stale(-10.0f, 6.0f, 0.2f);
+  Fixture::put(model, f.pixelOf(fresh), fresh, 5.0f);
+  Fixture::put(model, f.pixelOf(stale), stale, 0.5f);
+  // The sensor moved 2 m forward: the model must appear 2 m closer along x.
+  Eigen::Isometry3d model_from_scan = Eigen::Isometry3d::Identity();
+  model_from_scan.translation() << 2.0, 0.0, 0.0;
+  cpu::fuseSphericalModel(model, scan, f.spherical, model_from_scan, 11.0f, 10.0f, f.winners, fused);
+  const Vec3f moved = fresh - Vec3f(2.0f, 0.0f, 0.0f);
+  const size_t pixel = f.pixelOf(moved);
+  ASSERT_TRUE(fused.occupied(pixel));
+  EXPECT_TRUE(fused.vertex[pixel].isApprox(moved));
+  EXPECT_EQ(fused.countOccupied(), 1u) << "the point observed 10.5 s ago must have expired";
+}
+
+TEST(ModelUpdate, GroundMapKeepsTheCloserPointAndExpiresOldOnes) {
+  Fixture f;
+  BevImage model;
+  model.resize(f.bev.rows, f.bev.cols);
+  BevImage scan_ground;
+  scan_ground.resize(f.bev.rows, f.bev.cols);
+  BevImage fused;
+  fused.resize(f.bev.rows, f.bev.cols);
+  const auto cell_of = [&](const Vec3f& p) {
+    int row = 0;
+    int col = 0;
+    EXPECT_TRUE(f.bev.cellOf(p, row, col));
+    return row * f.bev.cols + col;
+  };
+  const Vec3f kept(10.02f, 3.03f, -1.73f);
+  const Vec3f old(-7.0f, 1.0f, -1.73f);
+  cpu::keepCloserGroundPoint(model, cell_of(kept), kept, 4.0f);
+  cpu::keepCloserGroundPoint(model, cell_of(old), old, 0.0f);
+  const Vec3f observed(10.08f, 3.01f, -1.74f);  // same cell, a little farther from the sensor
+  cpu::keepCloserGroundPoint(scan_ground, cell_of(observed), observed, 12.0f);
+  EXPECT_EQ(scan_ground.occupied_cells.size(), 1u);
+
+  cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(), 12.0f, 10.0f, fused);
+  EXPECT_EQ(fused.occupied_cells.size(), 1u);
+  EXPECT_TRUE(fused.vertex[cell_of(kept)].isApprox(kept));
+  EXPECT_FLOAT_EQ(fused.stamp[cell_of(kept)], 4.0f);
+}
+
+TEST(ModelUpdate, MemoryStaysConstantOverAThousandUpdates) {
+  Fixture f;
+  BevImage model;
+  model.resize(f.bev.rows, f.bev.cols);
+  BevImage fused;
+  fused.resize(f.bev.rows, f.bev.cols);
+  BevImage scan_ground;
+  scan_ground.resize(f.bev.rows, f.bev.cols);
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  step.translation() << 1.0, 0.0, 0.0;
+  for (int frame = 0; frame < 1000; ++frame) {
+    scan_ground.clear();
+    for (int i = 0; i < 50; ++i) {
+      const Vec3f p(-10.0f + 0.4f * i, 0.0f, -1.73f);
+      int row = 0;
+      int col = 0;
+      f.bev.cellOf(p, row, col);
+      cpu::keepCloserGroundPoint(scan_ground, row * f.bev.cols + col, p, 0.1f * frame);
+    }
+    cpu::fuseGroundModel(model, scan_ground, f.bev, step, 0.1f * frame, 10.0f, fused);
+    std::swap(model, fused);
+  }
+  // 10 s at 1 m a frame: at most 100 frames of 50 points each survive, and the map stays bounded.
+  EXPECT_LE(model.occupied_cells.size(), 100u * 50u);
+  EXPECT_EQ(model.cellCount(), static_cast<size_t>(f.bev.rows) * f.bev.cols);
+}
+
+}  // namespace
+}  // namespace elo

@@ -1,0 +1,198 @@
+// Projection, ground segmentation and normal estimation on exact scans of an analytic street.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+#include "analytic_scene.hpp"
+#include "core/cpu/stages.hpp"
+#include "elo/backend.hpp"
+
+namespace elo {
+namespace {
+
+using test::Surface;
+
+struct Projected {
+  test::ScanWithTruth truth;
+  std::unique_ptr<Backend> backend;
+};
+
+Projected projectStreet(Config config, bool use_ring = false, double range_noise = 0.0) {
+  config.runtime.threads = 2;
+  Projected result{test::scanScene(test::streetScene(), config.sensor, Eigen::Isometry3d::Identity(), 0.0, range_noise),
+                   makeBackend(config)};
+  if (!use_ring) result.truth.cloud.ring.clear();
+  result.backend->projectScan(result.truth.cloud, 0.0f);
+  return result;
+}
+
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
+TEST(Projection, EveryPixelHoldsAPointOfItsOwnAngularCell) {
+  const Config config;
+  Projected p = projectStreet(config);
+  const ScanImage& scan = p.backend->scan();
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  size_t occupied = 0;
+  for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
+    if (!scan.image.occupied(pixel)) continue;
+    ++occupied;
+    const int row = static_cast<int>(pixel) / projection.cols;
+    const int col = static_cast<int>(pixel) % projection.cols;
+    const Vec3f& v = scan.image.vertex[pixel];
+    ASSERT_EQ(v, p.truth.cloud.points[scan.point_index[pixel]]);  // round trip: pixel -> the same point
+    const double azimuth = std::atan2(v.y(), v.x());
+    const double elevation = std::asin(v.z() / v.norm());
+    const double column_width = 2.0 * M_PI / projection.cols;
+    const double row_height = projection.fov_span / projection.rows;
+    EXPECT_LE(azimuth, M_PI - col * column_width + 1e-5);
+    EXPECT_GE(azimuth, M_PI - (col + 1) * column_width - 1e-5);
+    EXPECT_LE(elevation, projection.fov_up - row * row_height + 1e-5);
+    EXPECT_GE(elevation, projection.fov_up - (row + 1) * row_height - 1e-5);
+    EXPECT_FLOAT_EQ(scan.image.range[pixel], v.norm());
+  }
+  EXPECT_GT(occupied, 60000u);
+  // Nothing closer than a pixel's point was lost: every point is at least as far as its pixel's point.
+  for (size_t i = 0; i < p.truth.cloud.size(); ++i) {
+    int row = 0;
+    int col = 0;
+    ASSERT_TRUE(projection.pixelOf(p.truth.cloud.points[i], row, col));
+    const size_t pixel = static_cast<size_t>(row) * projection.cols + col;
+    EXPECT_LE(scan.image.range[pixel], p.truth.cloud.points[i].norm());
+  }
+}
+
+TEST(Projection, TheClosestPointWinsAndTiesGoToTheFirst) {
+  Config config;
+  auto backend = makeBackend(config);
+  PointCloud cloud;
+  const Vec3f direction = Vec3f(1.0f, 0.2f, -0.1f).normalized();
+  cloud.points = {direction * 10.0f, direction * 5.0f, direction * 7.0f, direction * 5.0f};
+  for (int i = 0; i < 200; ++i) cloud.points.push_back(Vec3f(20.0f, -5.0f + 0.05f * i, 0.0f));  // elsewhere
+  backend->projectScan(cloud, 0.0f);
+  const ScanImage& scan = backend->scan();
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  int row = 0;
+  int col = 0;
+  ASSERT_TRUE(projection.pixelOf(cloud.points[0], row, col));
+  const size_t pixel = static_cast<size_t>(row) * projection.cols + col;
+  EXPECT_EQ(scan.point_index[pixel], 1);
+  EXPECT_FLOAT_EQ(scan.image.range[pixel], 5.0f);
+}
+
+TEST(Projection, RingFieldSelectsTheBeamsRow) {
+  const Config config;
+  Projected p = projectStreet(config, true);
+  const ScanImage& scan = p.backend->scan();
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  const std::vector<float> elevations = beamElevations(config.sensor);
+  for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
+    if (!scan.image.occupied(pixel)) continue;
+    const uint16_t ring = p.truth.cloud.ring[scan.point_index[pixel]];
+    EXPECT_EQ(static_cast<int>(pixel) / projection.cols, projection.rowOfElevation(elevations[ring]));
+  }
+}
+
+TEST(Projection, ElevationCorrectionRaisesElevationAtConstantRange) {
+  const float angle = static_cast<float>(0.195 * M_PI / 180.0);
+  const Vec3f p(12.0f, -5.0f, -1.5f);
+  const Vec3f q = correctElevation(p, std::cos(angle), std::sin(angle));
+  EXPECT_NEAR(q.norm(), p.norm(), 1e-5);
+  EXPECT_NEAR(std::atan2(q.y(), q.x()), std::atan2(p.y(), p.x()), 1e-6);
+  EXPECT_NEAR(std::asin(q.z() / q.norm()) - std::asin(p.z() / p.norm()), angle, 1e-6);
+}
+
+TEST(GroundSegmentation, SeparatesTheRoadFromWallsCarsAndPoles) {
+  Config config;
+  Projected p = projectStreet(config);
+  p.backend->segmentGround();
+  const ScanImage& scan = p.backend->scan();
+  size_t ground_points = 0;
+  size_t ground_labelled_ground = 0;
+  size_t object_labelled_ground = 0;
+  for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
+    if (!scan.image.occupied(pixel)) continue;
+    const bool truly_ground = p.truth.surface[scan.point_index[pixel]] == Surface::ground;
+    const bool labelled_ground = scan.label[pixel] == PixelLabel::ground;
+    ground_points += truly_ground;
+    ground_labelled_ground += truly_ground && labelled_ground;
+    object_labelled_ground += !truly_ground && labelled_ground;
+  }
+  EXPECT_GT(ground_points, 30000u);
+  // Only the last ring before an object can fail the slope test towards it.
+  EXPECT_GT(static_cast<double>(ground_labelled_ground) / ground_points, 0.97);
+  EXPECT_EQ(object_labelled_ground, 0u);
+}
+
+// Normals compared with the true plane, on pixels at least 0.5 m from any edge of their face (closer,
+// the neighbourhood spans two planes and no single normal is right).
+struct NormalErrors {
+  size_t with_normal = 0;
+  size_t wrong = 0;  // more than 5 deg from the true surface normal
+};
+
+NormalErrors normalErrors(NormalMethod method, double range_noise) {
+  Config config;
+  config.normals.method = method;
+  Projected p = projectStreet(config, false, range_noise);
+  p.backend->segmentGround();
+  p.backend->estimateNormals();
+  const ScanImage& scan = p.backend->scan();
+  NormalErrors errors;
+  for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
+    if (!scan.image.hasNormal(pixel)) continue;
+    EXPECT_EQ(scan.label[pixel], PixelLabel::nonground);
+    EXPECT_LT(scan.image.normal[pixel].dot(scan.image.vertex[pixel]), 0.0f) << "normal faces away";
+    const size_t point = scan.point_index[pixel];
+    if (p.truth.edge_distance[point] < 0.5) continue;
+    ++errors.with_normal;
+    errors.wrong += angleDeg(scan.image.normal[pixel].cast<double>(), p.truth.normal[point]) > 5.0;
+  }
+  return errors;
+}
+
+double wrongFraction(const NormalErrors& errors) {
+  return static_cast<double>(errors.wrong) / static_cast<double>(errors.with_normal);
+}
+
+TEST(NormalEstimation, RangeAdaptiveNormalsMatchTheTruePlanes) {
+  const NormalErrors exact = normalErrors(NormalMethod::range_adaptive, 0.0);
+  EXPECT_GT(exact.with_normal, 15000u);
+  EXPECT_EQ(exact.wrong, 0u);
+}
+
+TEST(NormalEstimation, RangeAdaptiveBeatsTheBaselinesOnNoisyScans) {
+  // With the 2 cm range noise of a real HDL-64E, image-gradient cross products and a fixed window
+  // without outlier tests give many more wrong normals than the range-adaptive estimator (Table III).
+  // Measured: range-adaptive 1.8 %, eigen 3.4 %, cross product 79 % of normals off by more than 5 deg.
+  const NormalErrors adaptive = normalErrors(NormalMethod::range_adaptive, 0.02);
+  const NormalErrors eigen = normalErrors(NormalMethod::eigen, 0.02);
+  const NormalErrors cross = normalErrors(NormalMethod::cross_product, 0.02);
+  std::cout << "wrong normals (>5 deg) with 2 cm noise: range-adaptive " << adaptive.wrong << "/"
+            << adaptive.with_normal << ", eigen " << eigen.wrong << "/" << eigen.with_normal << ", cross product "
+            << cross.wrong << "/" << cross.with_normal << std::endl;
+  EXPECT_LT(wrongFraction(adaptive), 0.02);
+  EXPECT_GT(wrongFraction(eigen), 1.5 * wrongFraction(adaptive));
+  EXPECT_GT(wrongFraction(cross), 5.0 * wrongFraction(adaptive));
+}
+
+TEST(NormalEstimation, WindowFollowsRangeAsInPaperNotes) {
+  // PAPER_NOTES: r = 10 m gives a 13 x 5 window, r = 40 m gives 5 x 3 (Eq. 12, odd, clamped).
+  const Config config;
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  const cpu::WindowSize near = cpu::rangeAdaptiveWindow(config.normals, projection, 10.0f);
+  const cpu::WindowSize far = cpu::rangeAdaptiveWindow(config.normals, projection, 40.0f);
+  EXPECT_EQ(near.width, 13);
+  EXPECT_EQ(near.height, 5);
+  EXPECT_EQ(far.width, 5);
+  EXPECT_EQ(far.height, 3);
+  const cpu::WindowSize close = cpu::rangeAdaptiveWindow(config.normals, projection, 3.0f);
+  EXPECT_EQ(close.width, 13);
+  EXPECT_EQ(close.height, 7);
+}
+
+}  // namespace
+}  // namespace elo
