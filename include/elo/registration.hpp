@@ -26,11 +26,25 @@ double fusionWeight(const NormalEquations& sums, const RegistrationConfig& confi
 // inlier count so that w keeps its meaning whatever the point counts.
 void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H, Vector6d& g);
 
-// The kernel scale of an iteration: it starts at the correspondence gate, where the kernel barely
-// weighs anything, and halves each iteration down to `robust_kernel_scale`. A tight kernel from the
-// start would ignore the very residuals a poor initial guess produces; a tight kernel at the end keeps
-// edge correspondences from biasing the solution.
-double annealedKernelScale(int iteration, const RegistrationConfig& config);
+// The scale of the robust kernel over the iterations. It starts at four times `robust_kernel_scale`
+// (at most the correspondence gate) and halves each iteration down to it; once the steps become small
+// under a loose kernel it jumps to the final one. A tight kernel from the start would
+// ignore the very residuals a poor initial guess produces; a tight kernel at the end keeps edge
+// correspondences from biasing the solution.
+class KernelSchedule {
+ public:
+  explicit KernelSchedule(const RegistrationConfig& config);
+  double scale() const { return scale_; }
+  bool isFinal() const { return scale_ == final_; }
+  // Moves to the next iteration's scale; returns true when a small step under the final scale ends the
+  // registration.
+  bool advance(bool step_was_small);
+
+ private:
+  static constexpr double kStartFactor = 4.0;
+  double final_;
+  double scale_;
+};
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess,
                                 const RegistrationConfig& config);

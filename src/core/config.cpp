@@ -210,7 +210,7 @@ void validate(const Config& c) {
   require(b.half_width > 0.0, "bev.half_width", "must be positive");
   const double cells = (2.0 * b.half_length / b.cell_size) * (2.0 * b.half_width / b.cell_size);
   require(cells <= 1e8, "bev.cell_size", "gives more than 1e8 BEV cells: enlarge it or shrink the extents");
-  require(b.normal_neighbours >= 3, "bev.normal_neighbours", "must be at least 3");
+  require(b.normal_neighbours >= 3 && b.normal_neighbours <= 32, "bev.normal_neighbours", "must lie in [3, 32]");
   require(b.normal_patch_radius >= 1, "bev.normal_patch_radius", "must be at least 1");
 
   const RegistrationConfig& r = c.registration;

@@ -2,7 +2,6 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <cmath>
 
 namespace elo {
 
@@ -49,20 +48,28 @@ void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H
   }
 }
 
-double annealedKernelScale(int iteration, const RegistrationConfig& config) {
-  if (config.robust_kernel_scale <= 0.0) return 0.0;
-  const double start = std::max(config.max_correspondence_distance, config.robust_kernel_scale);
-  return std::max(config.robust_kernel_scale, start * std::pow(0.5, iteration));
+KernelSchedule::KernelSchedule(const RegistrationConfig& config)
+    : final_(config.robust_kernel_scale),
+      scale_(std::min(config.max_correspondence_distance, kStartFactor * config.robust_kernel_scale)) {}
+
+bool KernelSchedule::advance(bool step_was_small) {
+  if (step_was_small) {
+    if (isFinal()) return true;
+    scale_ = final_;  // converged under a loose kernel: refine under the final one at once
+  } else {
+    scale_ = std::max(final_, 0.5 * scale_);
+  }
+  return false;
 }
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess,
                                 const RegistrationConfig& config) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
+  KernelSchedule kernel(config);
   Vector6d g;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    const double kernel_scale = annealedKernelScale(iteration, config);
-    result.last = backend.linearize(result.model_from_scan, kernel_scale);
+    result.last = backend.linearize(result.model_from_scan, kernel.scale());
     result.weight = fusionWeight(result.last, config);
     fuseNormalEquations(result.last, result.weight, result.hessian, g);
     result.iterations = iteration + 1;
@@ -79,9 +86,9 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
       return result;
     }
     result.model_from_scan = expSE3(step) * result.model_from_scan;
-    const bool final_kernel = kernel_scale == config.robust_kernel_scale;
-    if (final_kernel && step.head<3>().norm() < config.converged_translation &&
-        step.tail<3>().norm() < config.converged_rotation) {
+    const bool small = step.head<3>().norm() < config.converged_translation &&
+                       step.tail<3>().norm() < config.converged_rotation;
+    if (kernel.advance(small)) {
       result.converged = true;
       break;
     }

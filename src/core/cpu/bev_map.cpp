@@ -13,6 +13,8 @@ namespace {
 // Below this middle eigenvalue (1 cm spread across the line) the points lie on one scan ring and the
 // plane through them could turn about it freely.
 constexpr double kMinCrossSpread = 1e-4;
+// Upper bound of bev.normal_neighbours honoured by the fixed-size buffers of the fit.
+constexpr int kMaxNormalNeighbours = 32;
 
 }  // namespace
 
@@ -54,25 +56,30 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
                                 int32_t cell) {
   if (states_[cell].load(std::memory_order_acquire) == fitted) return normals_[cell];
 
-  // The model points of the patch around the cell, nearest to its vertex first.
+  // The `normal_neighbours` model points of the patch nearest to the cell's vertex, kept sorted.
   const Vec3f& centre = model.vertex[cell];
   const int row = cell / projection.cols;
   const int col = cell % projection.cols;
   const int radius = config.normal_patch_radius;
-  std::array<std::pair<float, Vec3f>, 256> candidates;
-  int count = 0;
+  const int wanted = std::min(config.normal_neighbours, kMaxNormalNeighbours);
+  std::array<float, kMaxNormalNeighbours> distances;
+  std::array<Vec3f, kMaxNormalNeighbours> points;
+  int used = 0;
   for (int r = std::max(0, row - radius); r <= std::min(projection.rows - 1, row + radius); ++r) {
     for (int c = std::max(0, col - radius); c <= std::min(projection.cols - 1, col + radius); ++c) {
       const int32_t other = r * projection.cols + c;
-      if (!model.occupied(other) || count == static_cast<int>(candidates.size())) continue;
-      candidates[count++] = {(model.vertex[other] - centre).squaredNorm(), model.vertex[other]};
+      if (!model.occupied(other)) continue;
+      const float distance = (model.vertex[other] - centre).squaredNorm();
+      if (used == wanted && distance >= distances[used - 1]) continue;
+      int slot = used < wanted ? used++ : used - 1;
+      for (; slot > 0 && distances[slot - 1] > distance; --slot) {
+        distances[slot] = distances[slot - 1];
+        points[slot] = points[slot - 1];
+      }
+      distances[slot] = distance;
+      points[slot] = model.vertex[other];
     }
   }
-  const int used = std::min(count, config.normal_neighbours);
-  std::partial_sort(candidates.begin(), candidates.begin() + used, candidates.begin() + count,
-                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::array<Vec3f, 256> points;
-  for (int i = 0; i < used; ++i) points[i] = candidates[i].second;
 
   Vec3f normal = Vec3f::Zero();
   const PlaneFit fit = fitPlane(points.data(), used, centre);

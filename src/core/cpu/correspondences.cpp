@@ -41,8 +41,12 @@ void accumulate(const Vec3f& moved, const Vec3f& model_vertex, const Vec3f& norm
   ++sums.inliers;
 }
 
-// The model pixel with a normal nearest to `moved` within `radius` pixels of (row, col), or -1.
+// Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
+// otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
+// within `radius` pixels; -1 when there is none.
 int64_t nearestModelPixel(const SphericalImage& model, const Vec3f& moved, int row, int col, int radius) {
+  const size_t projected = static_cast<size_t>(row) * model.cols + col;
+  if (model.occupied(projected) && model.hasNormal(projected)) return static_cast<int64_t>(projected);
   int64_t best = -1;
   float best_distance = INFINITY;
   for (int r = std::max(0, row - radius); r <= std::min(model.rows - 1, row + radius); ++r) {
@@ -60,19 +64,56 @@ int64_t nearestModelPixel(const SphericalImage& model, const Vec3f& moved, int r
   return best;
 }
 
+// The model vertex associated with `moved` (Eq. 16): the one in its cell, or else the nearest in the
+// first ring of cells around it that holds any, up to `radius` rings out. Near the sensor the model is
+// dense and the cell itself answers; far out it is sparse and the search widens.
+int32_t associateGround(const BevImage& model, const BevProjection& projection, const Vec3f& moved, int row, int col,
+                        int radius) {
+  for (int ring = 0; ring <= radius; ++ring) {
+    int32_t best = -1;
+    float best_distance = INFINITY;
+    for (int r = std::max(0, row - ring); r <= std::min(projection.rows - 1, row + ring); ++r) {
+      const bool edge_row = r == row - ring || r == row + ring;
+      const int step = edge_row ? 1 : 2 * ring;  // inner rows: only the ring's two ends
+      for (int c = col - ring; c <= col + ring; c += std::max(step, 1)) {
+        if (c < 0 || c >= projection.cols) continue;
+        const int32_t cell = r * projection.cols + c;
+        if (!model.occupied(cell)) continue;
+        const float distance = (model.vertex[cell] - moved).squaredNorm();
+        if (distance < best_distance) {
+          best_distance = distance;
+          best = cell;
+        }
+      }
+    }
+    if (best >= 0) return best;
+  }
+  return -1;
+}
+
 }  // namespace
 
-TermSums nongroundSums(const ScanImage& scan, const SphericalImage& model, const SphericalProjection& projection,
-                       const Eigen::Isometry3d& model_from_scan, double kernel_scale,
-                       const RegistrationConfig& config) {
+std::vector<int32_t> registrationPixels(const ScanImage& scan) {
+  std::vector<int32_t> pixels;
+  for (size_t pixel = 0; pixel < scan.label.size(); ++pixel) {
+    if (scan.label[pixel] == PixelLabel::nonground && scan.image.hasNormal(pixel)) {
+      pixels.push_back(static_cast<int32_t>(pixel));
+    }
+  }
+  return pixels;
+}
+
+TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels, const SphericalImage& model,
+                       const SphericalProjection& projection, const Eigen::Isometry3d& model_from_scan,
+                       double kernel_scale, const RegistrationConfig& config) {
   const Motion motion(model_from_scan);
   const float max_distance_squared = static_cast<float>(config.max_correspondence_distance *
                                                         config.max_correspondence_distance);
   const float min_normal_cosine = static_cast<float>(std::cos(config.max_normal_angle_deg * M_PI / 180.0));
   const SphericalImage& image = scan.image;
-  return deterministicSum<TermSums>(image.pixelCount(), [&](size_t begin, size_t end, TermSums& sums) {
-    for (size_t pixel = begin; pixel < end; ++pixel) {
-      if (scan.label[pixel] != PixelLabel::nonground || !image.hasNormal(pixel)) continue;
+  return deterministicSum<TermSums>(pixels.size(), [&](size_t begin, size_t end, TermSums& sums) {
+    for (size_t i = begin; i < end; ++i) {
+      const int32_t pixel = pixels[i];
       ++sums.candidates;
       const Vec3f moved = motion.apply(image.vertex[pixel]);
       int row = 0;
@@ -102,20 +143,8 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
       int row = 0;
       int col = 0;
       if (!projection.cellOf(moved, row, col)) continue;
-      // The associated model vertex: the one nearest the moved point in the patch around its cell.
-      int32_t match = -1;
-      float best_distance = max_distance_squared;
-      for (int r = std::max(0, row - radius); r <= std::min(projection.rows - 1, row + radius); ++r) {
-        for (int c = std::max(0, col - radius); c <= std::min(projection.cols - 1, col + radius); ++c) {
-          const int32_t cell = r * projection.cols + c;
-          if (!model.occupied(cell)) continue;
-          const float distance = (model.vertex[cell] - moved).squaredNorm();
-          if (distance <= best_distance) {
-            best_distance = distance;
-            match = cell;
-          }
-        }
-      }
+      const int32_t match = associateGround(model, projection, moved, row, col, radius);
+      if (match < 0 || (model.vertex[match] - moved).squaredNorm() > max_distance_squared) continue;
       if (match < 0) continue;
       const Vec3f normal = normals.normal(model, projection, bev, match);
       if (normal.isZero()) continue;

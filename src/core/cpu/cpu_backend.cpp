@@ -48,6 +48,7 @@ void CpuBackend::segmentGround() {
 
 void CpuBackend::estimateNormals() {
   arena_.execute([&] { cpu::estimateNormals(config_.normals, spherical_, scan_); });
+  registration_pixels_ = registrationPixels(scan_);
 }
 
 void CpuBackend::buildGroundMap() { cpu::buildGroundMap(scan_, bev_, scan_ground_); }
@@ -57,8 +58,8 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
   const CostTerms terms = config_.registration.terms;
   arena_.execute([&] {
     if (terms != CostTerms::bev_ground) {
-      sums.nonground = nongroundSums(scan_, model_.nonground, spherical_, model_from_scan, kernel_scale,
-                                     config_.registration);
+      sums.nonground = nongroundSums(scan_, registration_pixels_, model_.nonground, spherical_, model_from_scan,
+                                     kernel_scale, config_.registration);
     }
     if (terms == CostTerms::fused || terms == CostTerms::bev_ground) {
       sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,

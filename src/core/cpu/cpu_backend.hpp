@@ -32,6 +32,7 @@ class CpuBackend final : public Backend {
   tbb::task_arena arena_;
 
   ScanImage scan_;
+  std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
   BevImage scan_ground_;
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_

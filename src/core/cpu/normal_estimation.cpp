@@ -42,24 +42,24 @@ class NormalEstimator {
   NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan)
       : config_(config), projection_(projection), scan_(scan), image_(scan.image) {}
 
-  void estimate(size_t pixel, std::vector<Vec3f>& neighbours) const {
+  // `offsets` is scratch space: the neighbours relative to the centre pixel's vertex.
+  void estimate(size_t pixel, std::vector<Vec3f>& offsets) const {
     if (scan_.label[pixel] != PixelLabel::nonground) return;
     if (config_.method == NormalMethod::cross_product) {
       image_.normal[pixel] = crossProductNormal(pixel);
       return;
     }
-    gatherNeighbours(pixel, windowOf(pixel), neighbours);
-    const Vec3f& centre = image_.vertex[pixel];
-    if (config_.method == NormalMethod::range_adaptive && !rejectDistantNeighbours(centre, neighbours)) return;
-    neighbours.push_back(centre);
-    PlaneFit fit = fitEnough(neighbours, centre);
+    const bool adaptive = config_.method == NormalMethod::range_adaptive;
+    if (!gatherNeighbours(pixel, windowOf(pixel), adaptive, offsets)) return;
+    offsets.push_back(Vec3f::Zero());  // the centre itself
+    PlaneFit fit = fitEnough(offsets);
     if (!fit.valid) return;
-    if (config_.method == NormalMethod::range_adaptive && dropOffPlane(centre, fit.normal, neighbours)) {
-      fit = fitEnough(neighbours, centre);
+    if (adaptive && dropOffPlane(fit.normal, offsets)) {
+      fit = fitEnough(offsets);
       if (!fit.valid) return;
     }
     if (fit.curvature > config_.max_curvature) return;
-    image_.normal[pixel] = towardsSensor(fit.normal, centre);
+    image_.normal[pixel] = towardsSensor(fit.normal, image_.vertex[pixel]);
   }
 
  private:
@@ -79,44 +79,52 @@ class NormalEstimator {
     return static_cast<size_t>(row) * projection_.cols + wrapped;
   }
 
-  void gatherNeighbours(size_t pixel, const Window& window, std::vector<Vec3f>& neighbours) const {
-    neighbours.clear();
-    const int row = static_cast<int>(pixel) / projection_.cols;
-    const int col = static_cast<int>(pixel) % projection_.cols;
-    for (int r = row - window.half_height; r <= row + window.half_height; ++r) {
-      for (int c = col - window.half_width; c <= col + window.half_width; ++c) {
-        if ((r == row && c == col) || !usable(r, c)) continue;
-        neighbours.push_back(image_.vertex[index(r, c)]);
+  // Collects the window's non-ground neighbours as offsets from the centre. With `reject_distant`, test 1
+  // of the paper: neighbours farther than sigma_r are left out, and when they are more than half of
+  // all, the centre is an outlier and gets no normal (returns false).
+  bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, std::vector<Vec3f>& offsets) const {
+    offsets.clear();
+    const int cols = projection_.cols;
+    const int row = static_cast<int>(pixel) / cols;
+    const int col = static_cast<int>(pixel) % cols;
+    const Vec3f& centre = image_.vertex[pixel];
+    const float limit = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
+    int total = 0;
+    int distant = 0;
+    for (int r = std::max(0, row - window.half_height); r <= std::min(projection_.rows - 1, row + window.half_height);
+         ++r) {
+      const size_t row_start = static_cast<size_t>(r) * cols;
+      for (int dc = -window.half_width; dc <= window.half_width; ++dc) {
+        int c = col + dc;
+        c += c < 0 ? cols : (c >= cols ? -cols : 0);  // azimuth is circular
+        const size_t neighbour = row_start + c;
+        if (neighbour == pixel || scan_.label[neighbour] != PixelLabel::nonground) continue;
+        const Vec3f offset = image_.vertex[neighbour] - centre;
+        ++total;
+        if (reject_distant && offset.squaredNorm() > limit) {
+          ++distant;
+          continue;
+        }
+        offsets.push_back(offset);
       }
     }
-  }
-
-  // Test 1: the point is an outlier when more than half its neighbours lie farther than sigma_r;
-  // otherwise those far neighbours leave the fit. Returns false for an outlier.
-  bool rejectDistantNeighbours(const Vec3f& centre, std::vector<Vec3f>& neighbours) const {
-    const float limit = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
-    const size_t total = neighbours.size();
-    const auto far = std::remove_if(neighbours.begin(), neighbours.end(),
-                                    [&](const Vec3f& q) { return (q - centre).squaredNorm() > limit; });
-    const size_t far_count = static_cast<size_t>(neighbours.end() - far);
-    neighbours.erase(far, neighbours.end());
-    return 2 * far_count <= total;
+    return 2 * distant <= total;
   }
 
   // Test 2: neighbours farther than sigma_z from the plane through the centre leave the fit.
   // Returns whether any left.
-  bool dropOffPlane(const Vec3f& centre, const Vec3f& normal, std::vector<Vec3f>& neighbours) const {
+  bool dropOffPlane(const Vec3f& normal, std::vector<Vec3f>& offsets) const {
     const float limit = static_cast<float>(config_.plane_distance);
-    const size_t before = neighbours.size();
-    neighbours.erase(std::remove_if(neighbours.begin(), neighbours.end(),
-                                    [&](const Vec3f& q) { return std::abs((q - centre).dot(normal)) > limit; }),
-                     neighbours.end());
-    return neighbours.size() != before;
+    const size_t before = offsets.size();
+    offsets.erase(std::remove_if(offsets.begin(), offsets.end(),
+                                 [&](const Vec3f& offset) { return std::abs(offset.dot(normal)) > limit; }),
+                  offsets.end());
+    return offsets.size() != before;
   }
 
-  PlaneFit fitEnough(const std::vector<Vec3f>& points, const Vec3f& centre) const {
-    if (static_cast<int>(points.size()) < config_.min_neighbours) return {};
-    return fitPlane(points.data(), static_cast<int>(points.size()), centre);
+  PlaneFit fitEnough(const std::vector<Vec3f>& offsets) const {
+    if (static_cast<int>(offsets.size()) < config_.min_neighbours) return {};
+    return fitPlane(offsets.data(), static_cast<int>(offsets.size()), Vec3f::Zero());
   }
 
   // The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away.

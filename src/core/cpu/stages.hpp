@@ -53,9 +53,11 @@ class GroundNormalCache {
 };
 
 // correspondences.cpp: the Gauss-Newton sums of each cost term for the scan moved by `model_from_scan`.
-TermSums nongroundSums(const ScanImage& scan, const SphericalImage& model, const SphericalProjection& projection,
-                       const Eigen::Isometry3d& model_from_scan, double kernel_scale,
-                       const RegistrationConfig& config);
+// The non-ground term runs over `pixels`: the non-ground pixels with a normal, listed once per scan.
+std::vector<int32_t> registrationPixels(const ScanImage& scan);
+TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels, const SphericalImage& model,
+                       const SphericalProjection& projection, const Eigen::Isometry3d& model_from_scan,
+                       double kernel_scale, const RegistrationConfig& config);
 TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const BevProjection& projection,
                     GroundNormalCache& normals, const Eigen::Isometry3d& model_from_scan, double kernel_scale,
                     const RegistrationConfig& registration, const BevConfig& bev);

@@ -1,0 +1,51 @@
+// The KITTI odometry benchmark metric, as the devkit's evaluate_odometry.cpp defines it: relative
+// errors of all segments of 100, 200, ..., 800 m of ground-truth path, starting at every 10th frame.
+// The devkit computes in float; this computes the same quantities in double.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <vector>
+
+namespace elo {
+
+// The devkit's `lengths` (m) and `step_size` (frames between segment starts).
+const std::vector<double>& kittiSegmentLengths();
+constexpr size_t kKittiStartFrameStep = 10;
+
+struct SegmentError {
+  size_t first_frame = 0;
+  size_t last_frame = 0;
+  double length = 0.0;             // m: the nominal segment length
+  double rotation_error = 0.0;     // rad per m
+  double translation_error = 0.0;  // m per m
+};
+
+// Mean segment errors in the units the benchmark reports; NaN when there are no segments (a
+// trajectory shorter than 100 m).
+struct DriftError {
+  size_t segments = 0;
+  double t_rel_percent = 0.0;
+  double r_rel_deg_per_100m = 0.0;
+};
+
+struct LengthDriftError {
+  double length = 0.0;  // m
+  DriftError error;
+};
+
+// Path length (m) travelled from frame 0 to each frame: the sum of distances between consecutive poses.
+std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& poses);
+
+// Every segment of `ground_truth` with its error in `estimate`. Throws std::invalid_argument naming
+// both counts when the trajectories have different lengths.
+std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
+                                             const std::vector<Eigen::Isometry3d>& estimate);
+
+// The mean over `segments`; the devkit's overall figure pools the segments of all sequences this way.
+DriftError averageDrift(const std::vector<SegmentError>& segments);
+
+// The mean for each segment length that has segments, in increasing length (the devkit's error plots).
+std::vector<LengthDriftError> driftByLength(const std::vector<SegmentError>& segments);
+
+}  // namespace elo

@@ -1,0 +1,72 @@
+// A spinning multi-beam LiDAR: beams at the elevations of the sensor's table, fired together at each
+// of `azimuth_steps` azimuths per revolution. Each return has Gaussian range noise, weak echoes (dark,
+// oblique or far surfaces) are lost more often, some returns drop out at random, nothing comes back
+// from the sky or from beyond max_range, and the intensity falls with the angle of incidence.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "elo/config.hpp"
+#include "elo/sim/rng.hpp"
+#include "elo/sim/scene.hpp"
+#include "elo/types.hpp"
+
+namespace elo::sim {
+
+struct LidarOptions {
+  double dropout_probability = 0.01;  // chance that any return is lost (dust, spray, ...)
+  // A return's echo strength is reflectivity * cos(incidence) * (10 m / range)^2; it is detected with
+  // probability 1 - exp(-strength / detection_threshold). The default thins the road beyond about
+  // 50 m as on a real HDL-64E while walls stay visible to max range; 0 detects every echo.
+  double detection_threshold = 1e-4;
+  // true: the whole sweep is taken at its start pose (no motion distortion); false: each firing from
+  // the pose at its own time, as a real spinning sensor does while the vehicle moves.
+  bool deskewed = true;
+};
+
+// A sweep with the kind of surface behind each point (tests and statistics; not written out).
+struct SimulatedScan {
+  PointCloud cloud;
+  std::vector<SurfaceKind> surface;
+};
+
+class Lidar {
+ public:
+  // The noise is sensor.range_noise_stddev; throws std::invalid_argument for an unusable sensor.
+  Lidar(const SensorConfig& sensor, const LidarOptions& options);
+
+  // One revolution starting at `stamp`. `sensor_pose_at(time)` gives the sensor in the world frame;
+  // points are in the sensor frame of their firing, in firing order, with `ring` (0 = top beam) and
+  // `time` (offset from `stamp`). `seed` draws this sweep's noise and dropouts.
+  SimulatedScan sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
+                      double stamp, uint64_t seed) const;
+
+  int beamCount() const { return static_cast<int>(beam_directions_.size()); }
+  int azimuthSteps() const { return static_cast<int>(azimuth_cos_.size()); }
+  double sweepDuration() const { return 1.0 / sensor_.rotation_rate_hz; }
+  // Unit direction of a firing in the sensor frame.
+  Eigen::Vector3d direction(int beam, int step) const;
+  const SensorConfig& sensor() const { return sensor_; }
+
+ private:
+  struct Return {
+    double range = 0.0;  // exact distance to the surface, 0 for none
+    float intensity = 0.0f;
+    SurfaceKind kind = SurfaceKind::ground;
+  };
+  double firingTime(int step) const { return step * sweepDuration() / azimuthSteps(); }
+  std::vector<Return> castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const;
+  SimulatedScan addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const;
+  bool detected(const Return& result, Rng& rng) const;
+
+  SensorConfig sensor_;
+  LidarOptions options_;
+  std::vector<Eigen::Vector2d> beam_directions_;  // (cos, sin) of each beam's elevation
+  std::vector<double> azimuth_cos_;
+  std::vector<double> azimuth_sin_;
+};
+
+}  // namespace elo::sim

@@ -1,0 +1,23 @@
+// Writes a simulation as a KITTI-layout sequence: DIR/velodyne/%06d.bin, DIR/poses.txt (ground
+// truth in the sensor frame: scan i's pose in the frame of scan 0, so scan 0 is the identity),
+// DIR/times.txt (sweep starts, from 0) and DIR/calib.txt (KITTI 00's Tr, for devkit users who want
+// camera-frame poses: P_cam = Tr * P * Tr^-1).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "elo/sim/simulation.hpp"
+
+namespace elo::sim {
+
+struct SequenceSummary {
+  int frames = 0;
+  size_t points = 0;
+};
+
+// Frames are simulated in parallel (in the caller's TBB arena). Throws IoError when a file cannot
+// be written.
+SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory);
+
+}  // namespace elo::sim

@@ -1,0 +1,52 @@
+// The simulator assembled: a world built along a route, the vehicle standing on its ground, and the
+// LiDAR sweeping it once per frame.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "elo/config.hpp"
+#include "elo/sim/lidar.hpp"
+#include "elo/sim/trajectory.hpp"
+#include "elo/sim/world.hpp"
+
+namespace elo::sim {
+
+struct SimulationSpec {
+  WorldFamily world = WorldFamily::urban;
+  TrajectoryKind trajectory = TrajectoryKind::straight;
+  // When not empty, the vehicle drives through these LiDAR-frame poses (one per frame, e.g. KITTI
+  // ground truth) instead of the procedural `trajectory`.
+  std::vector<Eigen::Isometry3d> driven_poses;
+  int frames = 100;
+  uint64_t seed = 1;
+  Config config;  // the sensor, and ground.sensor_height for its mounting height
+  LidarOptions lidar;
+  int moving_cars = 0;
+};
+
+class Simulation {
+ public:
+  // Throws std::invalid_argument for a spec that cannot be simulated (no frames, fewer driven poses
+  // than frames, an unusable sensor).
+  explicit Simulation(const SimulationSpec& spec);
+
+  int frameCount() const { return spec_.frames; }
+  double stamp(int frame) const;  // start of the frame's sweep (s); frame 0 starts at 0
+  Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the sweep's start
+  SimulatedScan scan(int frame) const;
+
+  const World& world() const { return *world_; }
+  const Lidar& lidar() const { return lidar_; }
+  const SensorTrajectory& trajectory() const { return *trajectory_; }
+
+ private:
+  SimulationSpec spec_;
+  Lidar lidar_;
+  std::unique_ptr<World> world_;
+  std::unique_ptr<SensorTrajectory> trajectory_;
+};
+
+}  // namespace elo::sim

@@ -1,0 +1,263 @@
+// elo_run: runs the odometry over a sequence on disk (KITTI layout or a directory of PCD/BIN scans) and
+// writes the trajectory. Thin: parse flags, load scans, call elo::Odometry, report.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "elo/io/config_yaml.hpp"
+#include "elo/io/io_error.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/io/sequence.hpp"
+#include "elo/odometry.hpp"
+
+namespace {
+
+constexpr char kUsage[] = R"(usage: elo_run --input DIR --output POSES [options]
+
+Runs ELO odometry over DIR (KITTI layout: DIR/velodyne/*.bin with optional times.txt and calib.txt;
+or a directory of .pcd / .bin scans) and writes one KITTI pose line per scan (sensor frame, scan 0 at
+the origin). With DIR/calib.txt it also writes the camera-frame trajectory the KITTI devkit scores.
+
+options:
+  --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config)
+  --mode f2m|f2f       frame-to-model (default) or frame-to-frame
+  --threads N          CPU threads (default: all)
+  --set KEY=VALUE      override one parameter, e.g. --set ground.sensor_height=1.8 (repeatable)
+  --frames N           process only the first N scans
+  --timing CSV         per-frame stage times, iterations and inlier counts
+  --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
+  --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
+  --quiet              no progress bar
+  --dump-config        print the effective configuration as YAML and exit
+  --help
+)";
+
+struct Options {
+  std::string input;
+  std::string output;
+  std::string config_file;
+  std::string timing_csv;
+  std::string tum_output;
+  std::string camera_output;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  size_t max_frames = 0;
+  bool quiet = false;
+  bool dump_config = false;
+};
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+Options parseArguments(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(flag + " needs a value");
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else if (flag == "--input") {
+      options.input = value();
+    } else if (flag == "--output") {
+      options.output = value();
+    } else if (flag == "--config") {
+      options.config_file = value();
+    } else if (flag == "--mode") {
+      const std::string mode = value();
+      if (mode != "f2m" && mode != "f2f") throw UsageError("--mode must be f2m or f2f, got '" + mode + "'");
+      options.overrides.emplace_back("model.mode", mode == "f2m" ? "frame_to_model" : "frame_to_frame");
+    } else if (flag == "--threads") {
+      options.overrides.emplace_back("runtime.threads", value());
+    } else if (flag == "--set") {
+      const std::string assignment = value();
+      const size_t equals = assignment.find('=');
+      if (equals == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + assignment + "'");
+      options.overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
+    } else if (flag == "--frames") {
+      const std::string text = value();
+      try {
+        options.max_frames = std::stoul(text);
+      } catch (const std::exception&) {
+        throw UsageError("--frames expects a count, got '" + text + "'");
+      }
+    } else if (flag == "--timing") {
+      options.timing_csv = value();
+    } else if (flag == "--tum") {
+      options.tum_output = value();
+    } else if (flag == "--camera-output") {
+      options.camera_output = value();
+    } else if (flag == "--quiet") {
+      options.quiet = true;
+    } else if (flag == "--dump-config") {
+      options.dump_config = true;
+    } else {
+      throw UsageError("unknown option '" + flag + "'");
+    }
+  }
+  if (!options.dump_config && (options.input.empty() || options.output.empty())) {
+    throw UsageError("--input and --output are required");
+  }
+  return options;
+}
+
+elo::Config loadConfig(const Options& options) {
+  elo::Config config;
+  if (!options.config_file.empty()) elo::loadConfigYaml(options.config_file, config);
+  std::vector<elo::Parameter> table = elo::parameters(config);
+  for (const auto& [key, text] : options.overrides) {
+    const auto parameter = std::find_if(table.begin(), table.end(), [&](const auto& p) { return p.key == key; });
+    if (parameter == table.end()) throw elo::ConfigError("unknown parameter '" + key + "'");
+    elo::setFromString(*parameter, text);
+  }
+  elo::validate(config);
+  return config;
+}
+
+std::string cameraOutputPath(const Options& options) {
+  if (!options.camera_output.empty()) return options.camera_output;
+  const size_t dot = options.output.rfind('.');
+  const size_t slash = options.output.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return options.output + "_camera";
+  return options.output.substr(0, dot) + "_camera" + options.output.substr(dot);
+}
+
+// Median and mean of one stage's times.
+struct StageSummary {
+  double mean = 0.0;
+  double median = 0.0;
+};
+
+StageSummary summarise(std::vector<double> values) {
+  StageSummary summary;
+  if (values.empty()) return summary;
+  summary.mean = std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  summary.median = values[values.size() / 2];
+  return summary;
+}
+
+class Report {
+ public:
+  void add(const elo::FrameResult& result) {
+    if (!result.processed) return;
+    projection_.push_back(result.times.projection);
+    features_.push_back(result.times.feature_extraction);
+    registration_.push_back(result.times.registration);
+    model_update_.push_back(result.times.model_update);
+    total_.push_back(result.times.total);
+  }
+
+  void print(const elo::Odometry& odometry, size_t scans, double wall_seconds) const {
+    std::printf("\nframes: %zu scans, %zu processed", scans, odometry.processedCount());
+    for (const auto& [reason, count] : odometry.skippedCounts()) std::printf(", %zu skipped (%s)", count, reason.c_str());
+    std::printf("\n%-22s %10s %10s\n", "stage (ms)", "mean", "median");
+    const std::pair<const char*, const std::vector<double>*> rows[] = {
+        {"spherical projection", &projection_}, {"feature extraction", &features_},
+        {"ICP optimization", &registration_},   {"model update", &model_update_},
+        {"total", &total_}};
+    for (const auto& [name, values] : rows) {
+      const StageSummary s = summarise(*values);
+      std::printf("%-22s %10.2f %10.2f\n", name, s.mean, s.median);
+    }
+    const double mean_total = summarise(total_).mean;
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const int threads = odometry.config().runtime.threads;
+    std::printf("FPS: %.1f (pipeline), %.1f (wall, with reading scans); threads: %s; peak memory: %.0f MiB\n",
+                mean_total > 0.0 ? 1000.0 / mean_total : 0.0, wall_seconds > 0.0 ? total_.size() / wall_seconds : 0.0,
+                threads > 0 ? std::to_string(threads).c_str() : "all", usage.ru_maxrss / 1024.0);
+  }
+
+ private:
+  std::vector<double> projection_, features_, registration_, model_update_, total_;
+};
+
+void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {
+  csv << index << ',' << stamp << ',' << (r.processed ? 1 : 0) << ',' << r.times.projection << ','
+      << r.times.feature_extraction << ',' << r.times.registration << ',' << r.times.model_update << ','
+      << r.times.total << ',' << r.registration.iterations << ',' << r.registration.last.nonground.inliers << ','
+      << r.registration.last.ground.inliers << ',' << r.registration.weight << '\n';
+}
+
+void showProgress(size_t done, size_t total) {
+  constexpr int kWidth = 40;
+  const int filled = static_cast<int>(kWidth * done / std::max<size_t>(total, 1));
+  std::fprintf(stderr, "\r[%s%s] %zu/%zu", std::string(filled, '#').c_str(), std::string(kWidth - filled, ' ').c_str(),
+               done, total);
+  if (done == total) std::fprintf(stderr, "\n");
+}
+
+int run(const Options& options) {
+  const elo::Config config = loadConfig(options);
+  if (options.dump_config) {
+    std::cout << elo::dumpConfigYaml(config);
+    return 0;
+  }
+  const elo::Sequence sequence(options.input);
+  const size_t scans = options.max_frames > 0 ? std::min(options.max_frames, sequence.size()) : sequence.size();
+  elo::Odometry odometry(config);
+  std::ofstream timing;
+  if (!options.timing_csv.empty()) {
+    timing.open(options.timing_csv);
+    if (!timing) throw elo::IoError("cannot write " + options.timing_csv);
+    timing << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
+              "iterations,nonground_inliers,ground_inliers,weight\n";
+  }
+  const bool progress = !options.quiet && isatty(STDERR_FILENO);
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<double> stamps;
+  Report report;
+  size_t non_finite_points = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < scans; ++i) {
+    size_t non_finite = 0;
+    const elo::PointCloud cloud = sequence.load(i, &non_finite);
+    non_finite_points += non_finite;
+    const elo::FrameResult result = odometry.process(cloud);
+    if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", i, result.skip_reason.c_str());
+    if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", i);
+    poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned with scans
+    stamps.push_back(cloud.stamp);
+    report.add(result);
+    if (timing) writeTimingRow(timing, i, cloud.stamp, result);
+    if (progress) showProgress(i + 1, scans);
+  }
+  const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  elo::writeKittiPoses(options.output, poses);
+  if (sequence.hasCalibration()) {
+    elo::writeKittiPoses(cameraOutputPath(options), elo::lidarToCamera(poses, sequence.calibration()));
+  }
+  if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, stamps, poses);
+  if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
+  report.print(odometry, scans, wall_seconds);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArguments(argc, argv));
+  } catch (const UsageError& error) {
+    std::cerr << "elo_run: " << error.what() << "\n\n" << kUsage;
+    return 2;
+  } catch (const std::exception& error) {
+    std::cerr << "elo_run: " << error.what() << '\n';
+    return 1;
+  }
+}
