@@ -53,20 +53,26 @@ struct ScanImage {
   void clear();
 };
 
-// A bird's-eye-view map of ground points (Eq. 14): cell (u, v) holds one vertex. Occupied cells are
-// also listed, so that clearing and iterating cost the number of points, not the size of the grid.
+// A bird's-eye-view map of ground points (Eq. 14): cell (row, col) of a `rows x cols` grid holds at
+// most one point. The grid stores only an index into compact point arrays, so a map of millions of cells
+// costs 4 bytes a cell, and iterating or clearing it costs the number of points, not the grid size.
 struct BevImage {
   int rows = 0;  // along y
   int cols = 0;  // along x
+  std::vector<int32_t> point_of_cell;  // per cell: index of its point, -1 when empty
+  // Per point, in insertion order:
+  std::vector<int32_t> cell;
   std::vector<Vec3f> vertex;
-  std::vector<float> range;  // distance to the sensor, 0 = empty cell
-  std::vector<float> stamp;
-  std::vector<int32_t> occupied_cells;
+  std::vector<float> range;  // distance to the sensor
+  std::vector<float> stamp;  // when the point was observed (s since the first scan)
 
-  void resize(int image_rows, int image_cols);
-  void clear();
+  void resize(int grid_rows, int grid_cols);
+  void clear();  // no points, grid size kept
+  size_t size() const { return vertex.size(); }
   size_t cellCount() const { return static_cast<size_t>(rows) * static_cast<size_t>(cols); }
-  bool occupied(size_t cell) const { return range[cell] > 0.0f; }
+  bool occupied(size_t grid_cell) const { return point_of_cell[grid_cell] >= 0; }
+  // Puts the point into `grid_cell` unless the cell holds one closer to the sensor (Sec. III-D).
+  void keepCloser(int32_t grid_cell, const Vec3f& point, float point_stamp);
 };
 
 // The local map, in the frame of the latest scan (Sec. III-D): the non-ground vertex and normal maps

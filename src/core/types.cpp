@@ -35,18 +35,38 @@ void ScanImage::clear() {
   std::fill(label.begin(), label.end(), PixelLabel::empty);
 }
 
-void BevImage::resize(int image_rows, int image_cols) {
-  rows = image_rows;
-  cols = image_cols;
-  vertex.assign(cellCount(), Vec3f::Zero());
-  range.assign(cellCount(), 0.0f);
-  stamp.assign(cellCount(), 0.0f);
-  occupied_cells.clear();
+void BevImage::resize(int grid_rows, int grid_cols) {
+  rows = grid_rows;
+  cols = grid_cols;
+  point_of_cell.assign(cellCount(), -1);
+  cell.clear();
+  vertex.clear();
+  range.clear();
+  stamp.clear();
 }
 
 void BevImage::clear() {
-  for (int32_t cell : occupied_cells) range[cell] = 0.0f;
-  occupied_cells.clear();
+  for (int32_t grid_cell : cell) point_of_cell[grid_cell] = -1;
+  cell.clear();
+  vertex.clear();
+  range.clear();
+  stamp.clear();
+}
+
+void BevImage::keepCloser(int32_t grid_cell, const Vec3f& point, float point_stamp) {
+  const float point_range = point.norm();
+  int32_t& index = point_of_cell[grid_cell];
+  if (index < 0) {
+    index = static_cast<int32_t>(vertex.size());
+    cell.push_back(grid_cell);
+    vertex.push_back(point);
+    range.push_back(point_range);
+    stamp.push_back(point_stamp);
+  } else if (point_range < range[index]) {
+    vertex[index] = point;
+    range[index] = point_range;
+    stamp[index] = point_stamp;
+  }
 }
 
 }  // namespace elo

@@ -99,19 +99,25 @@ TEST(ModelUpdate, GroundMapKeepsTheCloserPointAndExpiresOldOnes) {
   };
   const Vec3f kept(10.02f, 3.03f, -1.73f);
   const Vec3f old(-7.0f, 1.0f, -1.73f);
-  cpu::keepCloserGroundPoint(model, cell_of(kept), kept, 4.0f);
-  cpu::keepCloserGroundPoint(model, cell_of(old), old, 0.0f);
+  model.keepCloser(cell_of(kept), kept, 4.0f);
+  model.keepCloser(cell_of(old), old, 0.0f);
   const Vec3f observed(10.08f, 3.01f, -1.74f);  // same cell, a little farther from the sensor
-  cpu::keepCloserGroundPoint(scan_ground, cell_of(observed), observed, 12.0f);
-  EXPECT_EQ(scan_ground.occupied_cells.size(), 1u);
+  scan_ground.keepCloser(cell_of(observed), observed, 12.0f);
+  const Vec3f closer(10.01f, 3.02f, -1.72f);  // and a closer one arriving later wins within the scan
+  scan_ground.keepCloser(cell_of(closer), closer, 12.0f);
+  ASSERT_EQ(scan_ground.size(), 1u);
+  EXPECT_TRUE(scan_ground.vertex[0].isApprox(closer));
 
   cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(), 12.0f, 10.0f, fused);
-  EXPECT_EQ(fused.occupied_cells.size(), 1u);
-  EXPECT_TRUE(fused.vertex[cell_of(kept)].isApprox(kept));
-  EXPECT_FLOAT_EQ(fused.stamp[cell_of(kept)], 4.0f);
+  ASSERT_EQ(fused.size(), 1u) << "the point observed 12 s ago must have expired";
+  const int32_t point = fused.point_of_cell[cell_of(kept)];
+  ASSERT_GE(point, 0);
+  EXPECT_TRUE(fused.vertex[point].isApprox(closer));
+  EXPECT_FLOAT_EQ(fused.stamp[point], 12.0f);
+  EXPECT_FALSE(fused.occupied(cell_of(old)));
 }
 
-TEST(ModelUpdate, MemoryStaysConstantOverAThousandUpdates) {
+TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
   Fixture f;
   BevImage model;
   model.resize(f.bev.rows, f.bev.cols);
@@ -120,22 +126,27 @@ TEST(ModelUpdate, MemoryStaysConstantOverAThousandUpdates) {
   BevImage scan_ground;
   scan_ground.resize(f.bev.rows, f.bev.cols);
   Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  step.translation() << 1.0, 0.0, 0.0;
+  step.translation() << 1.0, 0.0, 0.0;  // the sensor advances 1 m a frame
   for (int frame = 0; frame < 1000; ++frame) {
     scan_ground.clear();
     for (int i = 0; i < 50; ++i) {
       const Vec3f p(-10.0f + 0.4f * i, 0.0f, -1.73f);
       int row = 0;
       int col = 0;
-      f.bev.cellOf(p, row, col);
-      cpu::keepCloserGroundPoint(scan_ground, row * f.bev.cols + col, p, 0.1f * frame);
+      ASSERT_TRUE(f.bev.cellOf(p, row, col));
+      scan_ground.keepCloser(row * f.bev.cols + col, p, 0.1f * frame);
     }
     cpu::fuseGroundModel(model, scan_ground, f.bev, step, 0.1f * frame, 10.0f, fused);
     std::swap(model, fused);
   }
-  // 10 s at 1 m a frame: at most 100 frames of 50 points each survive, and the map stays bounded.
-  EXPECT_LE(model.occupied_cells.size(), 100u * 50u);
-  EXPECT_EQ(model.cellCount(), static_cast<size_t>(f.bev.rows) * f.bev.cols);
+  // A point seen at x = 0 one frame ago now lies at x = -1.
+  int row = 0;
+  int col = 0;
+  ASSERT_TRUE(f.bev.cellOf(Vec3f(-1.0f, 0.0f, -1.73f), row, col));
+  EXPECT_TRUE(model.occupied(row * f.bev.cols + col));
+  // 10 s at 1 m a frame: at most 100 frames of 50 points survive, and the grid never grows.
+  EXPECT_LE(model.size(), 100u * 50u);
+  EXPECT_EQ(model.point_of_cell.size(), static_cast<size_t>(f.bev.rows) * f.bev.cols);
 }
 
 }  // namespace

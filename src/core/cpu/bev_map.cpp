@@ -2,6 +2,7 @@
 // the model points nearest an associated cell.
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "core/cpu/plane_fit.hpp"
 #include "core/cpu/stages.hpp"
@@ -18,18 +19,6 @@ constexpr int kMaxNormalNeighbours = 32;
 
 }  // namespace
 
-void keepCloserGroundPoint(BevImage& map, int32_t cell, const Vec3f& vertex, float stamp) {
-  const float range = vertex.norm();
-  if (!map.occupied(cell)) {
-    map.occupied_cells.push_back(cell);
-  } else if (map.range[cell] <= range) {
-    return;
-  }
-  map.vertex[cell] = vertex;
-  map.range[cell] = range;
-  map.stamp[cell] = stamp;
-}
-
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground) {
   ground.clear();
   const SphericalImage& image = scan.image;
@@ -38,28 +27,51 @@ void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevI
     int row = 0;
     int col = 0;
     if (!projection.cellOf(image.vertex[pixel], row, col)) continue;
-    keepCloserGroundPoint(ground, row * projection.cols + col, image.vertex[pixel], image.stamp[pixel]);
+    ground.keepCloser(row * projection.cols + col, image.vertex[pixel], image.stamp[pixel]);
   }
 }
 
-void GroundNormalCache::resize(size_t cells) {
-  normals_.assign(cells, Vec3f::Zero());
-  states_ = std::make_unique<std::atomic<uint8_t>[]>(cells);
-  for (size_t i = 0; i < cells; ++i) states_[i].store(unknown, std::memory_order_relaxed);
+int32_t nearestGroundPoint(const BevImage& map, const BevProjection& projection, const Vec3f& point, int row, int col,
+                           int radius) {
+  for (int ring = 0; ring <= radius; ++ring) {
+    int32_t best = -1;
+    float best_distance = INFINITY;
+    for (int r = std::max(0, row - ring); r <= std::min(projection.rows - 1, row + ring); ++r) {
+      const bool edge_row = r == row - ring || r == row + ring;
+      const int step = edge_row || ring == 0 ? 1 : 2 * ring;  // inner rows: only the ring's two ends
+      for (int c = col - ring; c <= col + ring; c += step) {
+        if (c < 0 || c >= projection.cols) continue;
+        const int32_t candidate = map.point_of_cell[r * projection.cols + c];
+        if (candidate < 0) continue;
+        const float distance = (map.vertex[candidate] - point).squaredNorm();
+        if (distance < best_distance) {
+          best_distance = distance;
+          best = candidate;
+        }
+      }
+    }
+    if (best >= 0) return best;
+  }
+  return -1;
 }
 
-void GroundNormalCache::invalidate(const BevImage& model) {
-  for (int32_t cell : model.occupied_cells) states_[cell].store(unknown, std::memory_order_relaxed);
+void GroundNormalCache::reset(size_t points) {
+  if (points > capacity_) {
+    capacity_ = points + points / 2;
+    normals_.resize(capacity_);
+    states_ = std::make_unique<std::atomic<uint8_t>[]>(capacity_);
+  }
+  for (size_t i = 0; i < points; ++i) states_[i].store(unknown, std::memory_order_relaxed);
 }
 
 Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& projection, const BevConfig& config,
-                                int32_t cell) {
-  if (states_[cell].load(std::memory_order_acquire) == fitted) return normals_[cell];
+                                int32_t point) {
+  if (states_[point].load(std::memory_order_acquire) == fitted) return normals_[point];
 
   // The `normal_neighbours` model points of the patch nearest to the cell's vertex, kept sorted.
-  const Vec3f& centre = model.vertex[cell];
-  const int row = cell / projection.cols;
-  const int col = cell % projection.cols;
+  const Vec3f& centre = model.vertex[point];
+  const int row = model.cell[point] / projection.cols;
+  const int col = model.cell[point] % projection.cols;
   const int radius = config.normal_patch_radius;
   const int wanted = std::min(config.normal_neighbours, kMaxNormalNeighbours);
   std::array<float, kMaxNormalNeighbours> distances;
@@ -67,8 +79,8 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
   int used = 0;
   for (int r = std::max(0, row - radius); r <= std::min(projection.rows - 1, row + radius); ++r) {
     for (int c = std::max(0, col - radius); c <= std::min(projection.cols - 1, col + radius); ++c) {
-      const int32_t other = r * projection.cols + c;
-      if (!model.occupied(other)) continue;
+      const int32_t other = model.point_of_cell[r * projection.cols + c];
+      if (other < 0) continue;
       const float distance = (model.vertex[other] - centre).squaredNorm();
       if (used == wanted && distance >= distances[used - 1]) continue;
       int slot = used < wanted ? used++ : used - 1;
@@ -87,9 +99,9 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
     normal = fit.normal.z() < 0.0f ? Vec3f(-fit.normal) : fit.normal;  // ground normals point up
   }
   uint8_t expected = unknown;
-  if (states_[cell].compare_exchange_strong(expected, fitting, std::memory_order_acq_rel)) {
-    normals_[cell] = normal;
-    states_[cell].store(fitted, std::memory_order_release);
+  if (states_[point].compare_exchange_strong(expected, fitting, std::memory_order_acq_rel)) {
+    normals_[point] = normal;
+    states_[point].store(fitted, std::memory_order_release);
   }
   return normal;
 }

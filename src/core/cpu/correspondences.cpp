@@ -64,33 +64,6 @@ int64_t nearestModelPixel(const SphericalImage& model, const Vec3f& moved, int r
   return best;
 }
 
-// The model vertex associated with `moved` (Eq. 16): the one in its cell, or else the nearest in the
-// first ring of cells around it that holds any, up to `radius` rings out. Near the sensor the model is
-// dense and the cell itself answers; far out it is sparse and the search widens.
-int32_t associateGround(const BevImage& model, const BevProjection& projection, const Vec3f& moved, int row, int col,
-                        int radius) {
-  for (int ring = 0; ring <= radius; ++ring) {
-    int32_t best = -1;
-    float best_distance = INFINITY;
-    for (int r = std::max(0, row - ring); r <= std::min(projection.rows - 1, row + ring); ++r) {
-      const bool edge_row = r == row - ring || r == row + ring;
-      const int step = edge_row ? 1 : 2 * ring;  // inner rows: only the ring's two ends
-      for (int c = col - ring; c <= col + ring; c += std::max(step, 1)) {
-        if (c < 0 || c >= projection.cols) continue;
-        const int32_t cell = r * projection.cols + c;
-        if (!model.occupied(cell)) continue;
-        const float distance = (model.vertex[cell] - moved).squaredNorm();
-        if (distance < best_distance) {
-          best_distance = distance;
-          best = cell;
-        }
-      }
-    }
-    if (best >= 0) return best;
-  }
-  return -1;
-}
-
 }  // namespace
 
 std::vector<int32_t> registrationPixels(const ScanImage& scan) {
@@ -135,15 +108,15 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
   const float max_distance_squared = static_cast<float>(registration.max_correspondence_distance *
                                                         registration.max_correspondence_distance);
   const int radius = bev.normal_patch_radius;
-  const auto& cells = scan_ground.occupied_cells;
-  return deterministicSum<TermSums>(cells.size(), [&](size_t begin, size_t end, TermSums& sums) {
+  return deterministicSum<TermSums>(scan_ground.size(), [&](size_t begin, size_t end, TermSums& sums) {
     for (size_t i = begin; i < end; ++i) {
       ++sums.candidates;
-      const Vec3f moved = motion.apply(scan_ground.vertex[cells[i]]);
+      const Vec3f moved = motion.apply(scan_ground.vertex[i]);
       int row = 0;
       int col = 0;
       if (!projection.cellOf(moved, row, col)) continue;
-      const int32_t match = associateGround(model, projection, moved, row, col, radius);
+      // Eq. 16: the model point in the moved point's cell; where the model is sparse, the nearest around it.
+      const int32_t match = nearestGroundPoint(model, projection, moved, row, col, radius);
       if (match < 0 || (model.vertex[match] - moved).squaredNorm() > max_distance_squared) continue;
       if (match < 0) continue;
       const Vec3f normal = normals.normal(model, projection, bev, match);

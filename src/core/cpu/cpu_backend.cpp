@@ -27,7 +27,6 @@ CpuBackend::CpuBackend(const Config& config)
   allocate(model_, spherical_, bev_);
   allocate(fused_, spherical_, bev_);
   winners_.resize(scan_.image.pixelCount());
-  ground_normals_.resize(model_.ground.cellCount());
 }
 
 size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp) {
@@ -70,9 +69,9 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
 }
 
 void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) {
-  ground_normals_.invalidate(model_.ground);
   if (!model_.initialized || config_.model.mode == RegistrationMode::frame_to_frame) {
     arena_.execute([&] { copyScanToModel(scan_, scan_ground_, model_); });
+    ground_normals_.reset(model_.ground.size());
     return;
   }
   const float window = static_cast<float>(config_.model.time_window);
@@ -83,10 +82,10 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, stamp, window, fused_.ground);
   std::swap(model_, fused_);
   model_.initialized = true;
+  ground_normals_.reset(model_.ground.size());
 }
 
 void CpuBackend::resetModel() {
-  ground_normals_.invalidate(model_.ground);
   model_.nonground.clear();
   model_.ground.clear();
   model_.initialized = false;

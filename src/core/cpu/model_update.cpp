@@ -58,16 +58,16 @@ void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const B
                      const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused) {
   const Eigen::Isometry3f scan_from_model = model_from_scan.inverse().cast<float>();
   fused.clear();
-  for (int32_t cell : model.occupied_cells) {
-    if (stamp - model.stamp[cell] > time_window) continue;
-    const Vec3f moved = scan_from_model * model.vertex[cell];
+  for (size_t point = 0; point < model.size(); ++point) {
+    if (stamp - model.stamp[point] > time_window) continue;
+    const Vec3f moved = scan_from_model * model.vertex[point];
     int row = 0;
     int col = 0;
     if (!projection.cellOf(moved, row, col)) continue;
-    keepCloserGroundPoint(fused, row * projection.cols + col, moved, model.stamp[cell]);
+    fused.keepCloser(row * projection.cols + col, moved, model.stamp[point]);
   }
-  for (int32_t cell : scan_ground.occupied_cells) {
-    keepCloserGroundPoint(fused, cell, scan_ground.vertex[cell], scan_ground.stamp[cell]);
+  for (size_t point = 0; point < scan_ground.size(); ++point) {
+    fused.keepCloser(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point]);
   }
 }
 
@@ -82,8 +82,8 @@ void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& 
     target.stamp[pixel] = observed.stamp[pixel];
   });
   model.ground.clear();
-  for (int32_t cell : scan_ground.occupied_cells) {
-    keepCloserGroundPoint(model.ground, cell, scan_ground.vertex[cell], scan_ground.stamp[cell]);
+  for (size_t point = 0; point < scan_ground.size(); ++point) {
+    model.ground.keepCloser(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point]);
   }
   model.initialized = true;
 }

@@ -5,7 +5,6 @@
 // estimators are the baselines of Table III.
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/plane_fit.hpp"
@@ -42,20 +41,24 @@ class NormalEstimator {
   NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan)
       : config_(config), projection_(projection), scan_(scan), image_(scan.image) {}
 
-  // `offsets` is scratch space: the neighbours relative to the centre pixel's vertex.
-  void estimate(size_t pixel, std::vector<Vec3f>& offsets) const {
+  void estimate(size_t pixel) const {
     if (scan_.label[pixel] != PixelLabel::nonground) return;
     if (config_.method == NormalMethod::cross_product) {
       image_.normal[pixel] = crossProductNormal(pixel);
       return;
     }
     const bool adaptive = config_.method == NormalMethod::range_adaptive;
-    if (!gatherNeighbours(pixel, windowOf(pixel), adaptive, offsets)) return;
-    offsets.push_back(Vec3f::Zero());  // the centre itself
-    PlaneFit fit = fitEnough(offsets);
+    const Window window = windowOf(pixel);
+    PointMoments moments;
+    if (!gatherNeighbours(pixel, window, adaptive, nullptr, moments)) return;
+    PlaneFit fit = fitEnough(moments);
     if (!fit.valid) return;
-    if (adaptive && dropOffPlane(fit.normal, offsets)) {
-      fit = fitEnough(offsets);
+    // Test 2 can only drop a neighbour when sigma_z < sigma_r: |d.n| <= |d|, and test 1 already left out
+    // every neighbour with |d| > sigma_r. With the paper's values (both 0.5 m) the refit is a no-op.
+    if (adaptive && config_.plane_distance < config_.outlier_distance) {
+      PointMoments on_plane;
+      gatherNeighbours(pixel, window, true, &fit.normal, on_plane);
+      if (on_plane.count != moments.count) fit = fitEnough(on_plane);
       if (!fit.valid) return;
     }
     if (fit.curvature > config_.max_curvature) return;
@@ -79,17 +82,19 @@ class NormalEstimator {
     return static_cast<size_t>(row) * projection_.cols + wrapped;
   }
 
-  // Collects the window's non-ground neighbours as offsets from the centre. With `reject_distant`, test 1
-  // of the paper: neighbours farther than sigma_r are left out, and when they are more than half of
-  // all, the centre is an outlier and gets no normal (returns false).
-  bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, std::vector<Vec3f>& offsets) const {
-    offsets.clear();
+  // Accumulates the window's non-ground pixels (the centre included) as offsets from the centre. With
+  // `reject_distant`, test 1 of the paper: neighbours farther than sigma_r are left out, and when they
+  // are more than half of all the centre is an outlier and gets no normal (returns false). With a
+  // `plane` normal, test 2: neighbours farther than sigma_z from the plane through the centre are left out.
+  bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, const Vec3f* plane,
+                        PointMoments& moments) const {
     const int cols = projection_.cols;
     const int row = static_cast<int>(pixel) / cols;
     const int col = static_cast<int>(pixel) % cols;
     const Vec3f& centre = image_.vertex[pixel];
-    const float limit = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
-    int total = 0;
+    const float distant_squared = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
+    const float plane_distance = static_cast<float>(config_.plane_distance);
+    int neighbours = 0;
     int distant = 0;
     for (int r = std::max(0, row - window.half_height); r <= std::min(projection_.rows - 1, row + window.half_height);
          ++r) {
@@ -98,33 +103,23 @@ class NormalEstimator {
         int c = col + dc;
         c += c < 0 ? cols : (c >= cols ? -cols : 0);  // azimuth is circular
         const size_t neighbour = row_start + c;
-        if (neighbour == pixel || scan_.label[neighbour] != PixelLabel::nonground) continue;
+        if (scan_.label[neighbour] != PixelLabel::nonground) continue;
         const Vec3f offset = image_.vertex[neighbour] - centre;
-        ++total;
-        if (reject_distant && offset.squaredNorm() > limit) {
+        ++neighbours;
+        if (reject_distant && offset.squaredNorm() > distant_squared) {
           ++distant;
           continue;
         }
-        offsets.push_back(offset);
+        if (plane && std::abs(offset.dot(*plane)) > plane_distance) continue;
+        moments.add(offset);
       }
     }
-    return 2 * distant <= total;
+    return 2 * distant <= neighbours - 1;  // the centre is not its own neighbour
   }
 
-  // Test 2: neighbours farther than sigma_z from the plane through the centre leave the fit.
-  // Returns whether any left.
-  bool dropOffPlane(const Vec3f& normal, std::vector<Vec3f>& offsets) const {
-    const float limit = static_cast<float>(config_.plane_distance);
-    const size_t before = offsets.size();
-    offsets.erase(std::remove_if(offsets.begin(), offsets.end(),
-                                 [&](const Vec3f& offset) { return std::abs(offset.dot(normal)) > limit; }),
-                  offsets.end());
-    return offsets.size() != before;
-  }
-
-  PlaneFit fitEnough(const std::vector<Vec3f>& offsets) const {
-    if (static_cast<int>(offsets.size()) < config_.min_neighbours) return {};
-    return fitPlane(offsets.data(), static_cast<int>(offsets.size()), Vec3f::Zero());
+  PlaneFit fitEnough(const PointMoments& moments) const {
+    if (moments.count < config_.min_neighbours) return {};
+    return fitPlane(moments);
   }
 
   // The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away.
@@ -165,14 +160,7 @@ class NormalEstimator {
 
 void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan) {
   const NormalEstimator estimator(config, projection, scan);
-  const size_t capacity = static_cast<size_t>(config.max_window_width) * config.max_window_height;
-  const size_t pixels = scan.image.pixelCount();
-  constexpr size_t kChunk = 1024;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, kChunk), [&](const tbb::blocked_range<size_t>& range) {
-    std::vector<Vec3f> neighbours;  // reused across the chunk: no allocation per pixel
-    neighbours.reserve(capacity);
-    for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) estimator.estimate(pixel, neighbours);
-  });
+  parallelFor(scan.image.pixelCount(), [&](size_t pixel) { estimator.estimate(pixel); });
 }
 
 }  // namespace elo::cpu

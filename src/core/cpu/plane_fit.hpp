@@ -14,30 +14,44 @@ struct PlaneFit {
   bool valid = false;
 };
 
-// `points[0..count)` are taken relative to `origin` so that float coordinates far from the sensor keep
-// their precision in the double covariance.
-inline PlaneFit fitPlane(const Vec3f* points, int count, const Vec3f& origin) {
-  PlaneFit fit;
-  if (count < 3) return fit;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int i = 0; i < count; ++i) mean += (points[i] - origin).cast<double>();
-  mean /= count;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d d = (points[i] - origin).cast<double>() - mean;
-    covariance.noalias() += d * d.transpose();
+// The first and second moments of a set of points, accumulated one point at a time. Points are given
+// relative to a nearby origin (the centre of a normal window), so float sums keep their precision.
+struct PointMoments {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  Eigen::Matrix3f outer = Eigen::Matrix3f::Zero();  // sum of p p^T
+  int count = 0;
+
+  void add(const Vec3f& p) {
+    sum += p;
+    outer.noalias() += p * p.transpose();
+    ++count;
   }
-  covariance /= count;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+};
+
+// The plane of the points whose moments are given: eigen-decomposition of their covariance (Eq. 10-11).
+inline PlaneFit fitPlane(const PointMoments& moments) {
+  PlaneFit fit;
+  if (moments.count < 3) return fit;
+  const Eigen::Vector3f mean = moments.sum / static_cast<float>(moments.count);
+  const Eigen::Matrix3f covariance = moments.outer / static_cast<float>(moments.count) - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
   solver.computeDirect(covariance);
-  const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
-  const double sum = eigenvalues.sum();
-  if (!(sum > 0.0)) return fit;
-  fit.normal = solver.eigenvectors().col(0).cast<float>().normalized();
-  fit.curvature = static_cast<float>(std::max(eigenvalues(0), 0.0) / sum);
+  const Eigen::Vector3f eigenvalues = solver.eigenvalues();  // ascending
+  const float sum = eigenvalues.sum();
+  if (!(sum > 0.0f)) return fit;
+  fit.normal = solver.eigenvectors().col(0).normalized();
+  fit.curvature = std::max(eigenvalues(0), 0.0f) / sum;
   fit.middle_eigenvalue = eigenvalues(1);
   fit.valid = fit.normal.allFinite();
   return fit;
+}
+
+// `points[0..count)` are taken relative to `origin` so that float coordinates far from the sensor keep
+// their precision.
+inline PlaneFit fitPlane(const Vec3f* points, int count, const Vec3f& origin) {
+  PointMoments moments;
+  for (int i = 0; i < count; ++i) moments.add(points[i] - origin);
+  return fitPlane(moments);
 }
 
 }  // namespace elo::cpu

@@ -33,21 +33,20 @@ void estimateNormals(const NormalConfig& config, const SphericalProjection& proj
 
 // bev_map.cpp: the BEV map of the ground pixels, closest point per cell.
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground);
-// Writes `vertex` into `map` unless the cell already holds a point closer to the sensor.
-void keepCloserGroundPoint(BevImage& map, int32_t cell, const Vec3f& vertex, float stamp);
 
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
 // (Sec. III-C.2) and kept until the model changes. Safe to query from many threads: a cell is fitted
 // from the model alone, so whichever thread fits it first stores the same value any other would.
 class GroundNormalCache {
  public:
-  void resize(size_t cells);
-  // Forgets the cells of `model` (call before the model changes).
-  void invalidate(const BevImage& model);
-  Vec3f normal(const BevImage& model, const BevProjection& projection, const BevConfig& config, int32_t cell);
+  // Forgets every normal; call whenever the model changes, with its new point count.
+  void reset(size_t points);
+  // The normal of model point `point` (zero when its neighbours give no plane).
+  Vec3f normal(const BevImage& model, const BevProjection& projection, const BevConfig& config, int32_t point);
 
  private:
   enum State : uint8_t { unknown = 0, fitting = 1, fitted = 2 };
+  size_t capacity_ = 0;
   std::vector<Vec3f> normals_;
   std::unique_ptr<std::atomic<uint8_t>[]> states_;
 };
@@ -69,6 +68,10 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
                         ClosestWins& winners, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused);
+// The point of `map` nearest to `point` in the cell of (row, col), or else in the first ring of cells
+// around it that holds any, up to `radius` rings out; -1 when there is none.
+int32_t nearestGroundPoint(const BevImage& map, const BevProjection& projection, const Vec3f& point, int row, int col,
+                           int radius);
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
 
