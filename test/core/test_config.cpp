@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "elo/config.hpp"
 
@@ -96,6 +98,21 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   config = Config();
   config.bev.cell_size = 0.001;
   EXPECT_NE(message_of(config).find("bev.cell_size"), std::string::npos);
+}
+
+TEST(Config, EveryParameterIsDocumentedInTheReadme) {
+  std::ifstream file(std::string(ELO_SOURCE_DIR) + "/README.md");
+  ASSERT_TRUE(file) << "README.md not found";
+  std::stringstream text;
+  text << file.rdbuf();
+  const std::string readme = text.str();
+  const size_t table = readme.find("## Parameters");
+  ASSERT_NE(table, std::string::npos);
+  Config config;
+  for (const Parameter& parameter : parameters(config)) {
+    const std::string name = parameter.key.substr(parameter.key.find('.') + 1);
+    EXPECT_NE(readme.find(name + "`", table), std::string::npos) << parameter.key << " is missing from the README";
+  }
 }
 
 }  // namespace
