@@ -13,7 +13,8 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libeigen3-dev libtbb-dev libyaml-cpp-dev libpcl-dev libgtest-dev gnuplot-nox \
   libroscpp-dev libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev \
   libpcl-ros-dev libpcl-conversions-dev librostest-dev python3-rostest libsensor-msgs-dev \
-  libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster
+  libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
+  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools
 
 .PHONY: deps build test bench clean
 
@@ -26,7 +27,8 @@ deps:
 	fi
 
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_SHARED_DATA=$(SHARED_DATA)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_SHARED_DATA=$(SHARED_DATA) \
+	  -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
 	cmake --build $(BUILD) -j$(JOBS)
 
 test: build

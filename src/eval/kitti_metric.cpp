@@ -1,0 +1,103 @@
+#include "elo/eval/kitti_metric.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <optional>
+
+#include "relative_motion.hpp"
+
+namespace elo {
+namespace {
+
+using eval_detail::generalInverse;
+using eval_detail::relativeMotion;
+
+// The devkit's rotationError: the angle from the trace, clamped against rounding.
+double devkitRotationAngle(const Eigen::Isometry3d& pose_error) {
+  const double cos_angle = 0.5 * (pose_error.linear().trace() - 1.0);
+  return std::acos(std::clamp(cos_angle, -1.0, 1.0));
+}
+
+// The devkit's lastFrameFromSegmentLength: the first frame whose distance exceeds the start's by more
+// than `length`. The devkit scans linearly; distances never decrease, so a binary search finds the
+// same frame.
+std::optional<size_t> lastFrameOfSegment(const std::vector<double>& distances, size_t first_frame, double length) {
+  const auto last = std::upper_bound(distances.begin() + static_cast<std::ptrdiff_t>(first_frame), distances.end(),
+                                     distances[first_frame] + length);
+  if (last == distances.end()) {
+    return std::nullopt;
+  }
+  return static_cast<size_t>(last - distances.begin());
+}
+
+}  // namespace
+
+const std::vector<double>& kittiSegmentLengths() {
+  static const std::vector<double> lengths = {100, 200, 300, 400, 500, 600, 700, 800};
+  return lengths;
+}
+
+std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<double> distances(poses.size(), 0.0);
+  for (size_t i = 1; i < poses.size(); ++i) {
+    distances[i] = distances[i - 1] + (poses[i].translation() - poses[i - 1].translation()).norm();
+  }
+  return distances;
+}
+
+std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
+                                             const std::vector<Eigen::Isometry3d>& estimate) {
+  eval_detail::requireSameLength(ground_truth, estimate);
+  const std::vector<double> distances = trajectoryDistances(ground_truth);
+  std::vector<SegmentError> segments;
+  for (size_t first = 0; first < ground_truth.size(); first += kKittiStartFrameStep) {
+    for (double length : kittiSegmentLengths()) {
+      const std::optional<size_t> last = lastFrameOfSegment(distances, first, length);
+      if (!last) {
+        continue;
+      }
+      const Eigen::Isometry3d gt_motion = relativeMotion(ground_truth[first], ground_truth[*last]);
+      const Eigen::Isometry3d estimated_motion = relativeMotion(estimate[first], estimate[*last]);
+      const Eigen::Isometry3d pose_error = generalInverse(estimated_motion) * gt_motion;
+      segments.push_back({first, *last, length, devkitRotationAngle(pose_error) / length,
+                          pose_error.translation().norm() / length});
+    }
+  }
+  return segments;
+}
+
+DriftError averageDrift(const std::vector<SegmentError>& segments) {
+  DriftError drift;
+  drift.segments = segments.size();
+  if (segments.empty()) {
+    drift.t_rel_percent = drift.r_rel_deg_per_100m = std::numeric_limits<double>::quiet_NaN();
+    return drift;
+  }
+  double translation_sum = 0.0;
+  double rotation_sum = 0.0;
+  for (const SegmentError& segment : segments) {
+    translation_sum += segment.translation_error;
+    rotation_sum += segment.rotation_error;
+  }
+  const double count = static_cast<double>(segments.size());
+  drift.t_rel_percent = 100.0 * translation_sum / count;
+  drift.r_rel_deg_per_100m = 100.0 * (180.0 / M_PI) * rotation_sum / count;
+  return drift;
+}
+
+std::vector<LengthDriftError> driftByLength(const std::vector<SegmentError>& segments) {
+  std::vector<LengthDriftError> result;
+  for (double length : kittiSegmentLengths()) {
+    std::vector<SegmentError> of_length;
+    std::copy_if(segments.begin(), segments.end(), std::back_inserter(of_length),
+                 [length](const SegmentError& segment) { return segment.length == length; });
+    if (!of_length.empty()) {
+      result.push_back({length, averageDrift(of_length)});
+    }
+  }
+  return result;
+}
+
+}  // namespace elo

@@ -1,0 +1,127 @@
+// The elo_eval command line, run as a user runs it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "../io/temp_directory.hpp"
+#include "../io/test_helpers.hpp"
+#include "elo/io/kitti.hpp"
+#include "synthetic_trajectories.hpp"
+
+namespace elo {
+namespace {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandResult runEloEval(const std::string& arguments) {
+  CommandResult result;
+  FILE* pipe = popen((std::string(ELO_EVAL_BINARY) + " " + arguments + " 2>&1").c_str(), "r");
+  char buffer[4096];
+  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+bool contains(const std::string& text, const std::string& fragment) {
+  return text.find(fragment) != std::string::npos;
+}
+
+class EloEvalCli : public testing::Test {
+ protected:
+  void SetUp() override {
+    ground_truth_ = test::circle(1200, 1.0, 0.003);
+    std::filesystem::create_directories(directory_.path() / "gt");
+    std::filesystem::create_directories(directory_.path() / "est");
+    for (const char* sequence : {"00", "01"}) {
+      writeKittiPoses(directory_.file(std::string("gt/") + sequence + ".txt"), ground_truth_);
+      writeKittiPoses(directory_.file(std::string("est/") + sequence + ".txt"),
+                      test::scaleIncrements(ground_truth_, 1.01));
+    }
+  }
+
+  test::TempDirectory directory_;
+  std::vector<Eigen::Isometry3d> ground_truth_;
+};
+
+TEST_F(EloEvalCli, HelpPrintsUsage) {
+  const CommandResult result = runEloEval("--help");
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_TRUE(contains(result.output, "usage: elo_eval --gt GT --est EST")) << result.output;
+}
+
+TEST_F(EloEvalCli, FilesGiveOneRow) {
+  const CommandResult result = runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("est/00.txt"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "t_rel(%)")) << result.output;
+  EXPECT_TRUE(contains(result.output, "00 ")) << result.output;
+  EXPECT_FALSE(contains(result.output, "overall")) << result.output;
+}
+
+TEST_F(EloEvalCli, DirectoriesGiveARowPerSequenceAndOverall) {
+  const CommandResult result = runEloEval("--gt " + directory_.file("gt") + " --est " + directory_.file("est") +
+                                          " --plot " + directory_.file("plot.png"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  std::istringstream lines(result.output);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 4u) << result.output;
+  EXPECT_EQ(rows[1].substr(0, 2), "00");
+  EXPECT_EQ(rows[2].substr(0, 2), "01");
+  EXPECT_EQ(rows[3].substr(0, 7), "overall");
+  EXPECT_TRUE(contains(rows[3], " 2400 ")) << rows[3];
+  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
+    EXPECT_TRUE(std::filesystem::exists(directory_.file("plot_00.png")));
+    EXPECT_TRUE(std::filesystem::exists(directory_.file("plot_01.png")));
+    EXPECT_TRUE(std::filesystem::exists(directory_.file("plot.png")));
+  }
+}
+
+TEST_F(EloEvalCli, TumFiles) {
+  std::vector<double> stamps;
+  for (size_t i = 0; i < ground_truth_.size(); ++i) stamps.push_back(0.1 * static_cast<double>(i));
+  writeTumPoses(directory_.file("gt.tum"), stamps, ground_truth_);
+  writeTumPoses(directory_.file("est.tum"), stamps, ground_truth_);
+  const CommandResult result =
+      runEloEval("--tum --gt " + directory_.file("gt.tum") + " --est " + directory_.file("est.tum"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "0.0000")) << result.output;
+}
+
+TEST_F(EloEvalCli, MismatchedFrameCountsNameBoth) {
+  writeKittiPoses(directory_.file("short.txt"), test::circle(1000, 1.0, 0.003));
+  const CommandResult result =
+      runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("short.txt"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_TRUE(contains(result.output, "1200")) << result.output;
+  EXPECT_TRUE(contains(result.output, "1000")) << result.output;
+}
+
+TEST_F(EloEvalCli, BadArgumentsExitWith2) {
+  EXPECT_EQ(runEloEval("").exit_code, 2);
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt/00.txt")).exit_code, 2);
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt/00.txt") + " --est").exit_code, 2);
+  EXPECT_EQ(runEloEval("--bogus").exit_code, 2);
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt") + " --est " + directory_.file("est/00.txt")).exit_code, 2);
+}
+
+TEST_F(EloEvalCli, UnreadableFilesExitWith2NamingThem) {
+  const CommandResult missing = runEloEval("--gt /nonexistent/00.txt --est " + directory_.file("est/00.txt"));
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_TRUE(contains(missing.output, "/nonexistent/00.txt")) << missing.output;
+
+  test::writeText(directory_.file("broken.txt"), "1 2 3\n");
+  const CommandResult broken = runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("broken.txt"));
+  EXPECT_EQ(broken.exit_code, 2);
+  EXPECT_TRUE(contains(broken.output, directory_.file("broken.txt") + ":1")) << broken.output;
+}
+
+}  // namespace
+}  // namespace elo

@@ -1,0 +1,193 @@
+// elo_eval: KITTI drift, RPE and ATE of estimated trajectories against ground truth.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "elo/eval/evaluation.hpp"
+#include "elo/eval/plot.hpp"
+#include "elo/io/io_error.hpp"
+#include "elo/io/kitti.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+
+const char* const kUsage =
+    "usage: elo_eval --gt GT --est EST [--plot PNG] [--tum]\n"
+    "\n"
+    "Evaluates estimated trajectories against ground truth with the KITTI odometry metric (t_rel, r_rel over\n"
+    "segments of 100..800 m), the relative pose error between consecutive frames and the absolute trajectory\n"
+    "error after a rigid alignment.\n"
+    "\n"
+    "  --gt GT      a KITTI pose file (12 numbers a line), or a directory of NN.txt pose files\n"
+    "  --est EST    the estimate: a file when GT is a file, a directory when GT is one; every NN.txt present\n"
+    "               in both directories is evaluated, followed by an 'overall' row pooling all of them\n"
+    "  --plot PNG   also draw the trajectories and the error against segment length (needs gnuplot); with\n"
+    "               directories, sequence NN goes to PNG with _NN before the extension and the pooled errors\n"
+    "               to PNG itself\n"
+    "  --tum        the files are TUM trajectories (t x y z qx qy qz qw) instead of KITTI poses\n"
+    "  --help       this text\n"
+    "\n"
+    "Exit status: 0 on success, 2 on bad arguments or unreadable or mismatched inputs.\n";
+
+struct Options {
+  std::string ground_truth;
+  std::string estimate;
+  std::optional<std::string> plot;
+  bool tum = false;
+};
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+Options parseArguments(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(argument + " needs a value");
+      return argv[++i];
+    };
+    if (argument == "--gt") {
+      options.ground_truth = value();
+    } else if (argument == "--est") {
+      options.estimate = value();
+    } else if (argument == "--plot") {
+      options.plot = value();
+    } else if (argument == "--tum") {
+      options.tum = true;
+    } else {
+      throw UsageError("unknown argument '" + argument + "'");
+    }
+  }
+  if (options.ground_truth.empty() || options.estimate.empty()) {
+    throw UsageError("both --gt and --est are required");
+  }
+  return options;
+}
+
+std::vector<Eigen::Isometry3d> readTrajectory(const std::string& path, bool tum) {
+  if (!fs::is_regular_file(path)) {
+    throw elo::IoError("'" + path + "' is not a readable file");
+  }
+  std::vector<Eigen::Isometry3d> poses = tum ? elo::readTumPoses(path) : elo::readKittiPoses(path);
+  if (poses.empty()) {
+    throw elo::IoError("'" + path + "' holds no poses");
+  }
+  return poses;
+}
+
+// One sequence to evaluate: its name and its two files.
+struct SequenceFiles {
+  std::string name;
+  std::string ground_truth;
+  std::string estimate;
+};
+
+std::vector<SequenceFiles> pairSequenceFiles(const Options& options) {
+  const bool gt_is_directory = fs::is_directory(options.ground_truth);
+  if (gt_is_directory != fs::is_directory(options.estimate)) {
+    throw UsageError("--gt and --est must both be files or both be directories");
+  }
+  if (!gt_is_directory) {
+    return {{fs::path(options.estimate).stem().string(), options.ground_truth, options.estimate}};
+  }
+  std::vector<SequenceFiles> pairs;
+  for (const fs::directory_entry& entry : fs::directory_iterator(options.ground_truth)) {
+    const fs::path estimate = fs::path(options.estimate) / entry.path().filename();
+    if (entry.path().extension() == ".txt" && fs::exists(estimate)) {
+      pairs.push_back({entry.path().stem().string(), entry.path().string(), estimate.string()});
+    }
+  }
+  if (pairs.empty()) {
+    throw elo::IoError("no NN.txt file is present in both '" + options.ground_truth + "' and '" + options.estimate +
+                       "'");
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  return pairs;
+}
+
+std::string plotPathFor(const std::string& png, const std::string& sequence) {
+  const fs::path path(png);
+  return (path.parent_path() / (path.stem().string() + "_" + sequence + path.extension().string())).string();
+}
+
+void printHeader() {
+  std::printf("%-10s %8s %11s %9s %16s %12s %11s %9s\n", "sequence", "frames", "length(m)", "t_rel(%)",
+              "r_rel(deg/100m)", "RPE_trans(m)", "RPE_rot(deg)", "ATE(m)");
+}
+
+void printRow(const elo::TrajectoryEvaluation& evaluation) {
+  std::printf("%-10s %8zu %11.1f %9.4f %16.4f %12.5f %11.5f %9.4f\n", evaluation.name.c_str(), evaluation.frames,
+              evaluation.length_m, evaluation.drift.t_rel_percent, evaluation.drift.r_rel_deg_per_100m,
+              evaluation.rpe.translation_rmse_m, evaluation.rpe.rotation_rmse_deg, evaluation.ate.translation_rmse_m);
+}
+
+elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Options& options, bool plot_per_sequence) {
+  const std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
+  const std::vector<Eigen::Isometry3d> estimate = readTrajectory(files.estimate, options.tum);
+  elo::TrajectoryEvaluation evaluation;
+  try {
+    evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate);
+  } catch (const std::invalid_argument& error) {
+    throw elo::IoError("'" + files.ground_truth + "' against '" + files.estimate + "': " + error.what());
+  }
+  if (options.plot) {
+    const std::string png = plot_per_sequence ? plotPathFor(*options.plot, files.name) : *options.plot;
+    elo::plotEvaluation(png, ground_truth, estimate, elo::driftByLength(evaluation.segments),
+                        elo::TopView::widest_spread, "sequence " + files.name);
+  }
+  return evaluation;
+}
+
+int run(const Options& options) {
+  const std::vector<SequenceFiles> sequences = pairSequenceFiles(options);
+  const bool directories = fs::is_directory(options.ground_truth);
+  std::vector<elo::TrajectoryEvaluation> evaluations;
+  for (const SequenceFiles& files : sequences) {
+    evaluations.push_back(evaluateFiles(files, options, directories));
+  }
+  if (directories) {
+    evaluations.push_back(elo::poolEvaluations("overall", evaluations));
+    if (options.plot) {
+      elo::plotEvaluation(*options.plot, {}, {}, elo::driftByLength(evaluations.back().segments),
+                          elo::TopView::widest_spread, "all sequences");
+    }
+  }
+  // The table only once every input has been read, so that an error leaves no partial table.
+  printHeader();
+  for (const elo::TrajectoryEvaluation& evaluation : evaluations) {
+    printRow(evaluation);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+  }
+  try {
+    return run(parseArguments(argc, argv));
+  } catch (const UsageError& error) {
+    std::cerr << "elo_eval: " << error.what() << "\n\n" << kUsage;
+  } catch (const elo::IoError& error) {
+    std::cerr << "elo_eval: " << error.what() << "\n";
+  } catch (const fs::filesystem_error& error) {
+    std::cerr << "elo_eval: " << error.what() << "\n";
+  }
+  return kExitBadInput;
+}
