@@ -17,8 +17,13 @@ class MotionModel {
   // Records the estimated increment T^{t-1}_t that spanned `dt` seconds.
   void record(const Eigen::Isometry3d& increment, double dt);
   void reset() { history_ = 0; }
+  // Whether predictions come from the recorded motion of the configured prior (rather than identity or
+  // a shorter history): a registration may then start from a tight robust kernel.
+  bool informed() const { return prior_ == MotionPrior::none ? false : history_ >= requiredHistory(); }
 
  private:
+  int requiredHistory() const { return prior_ == MotionPrior::constant_acceleration ? 2 : 1; }
+
   MotionPrior prior_;
   int history_ = 0;            // how many of the velocities below are known
   Vector6d latest_velocity_;   // twist per second of the last increment

@@ -26,14 +26,14 @@ double fusionWeight(const NormalEquations& sums, const RegistrationConfig& confi
 // inlier count so that w keeps its meaning whatever the point counts.
 void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H, Vector6d& g);
 
-// The scale of the robust kernel over the iterations. It starts at four times `robust_kernel_scale`
-// (at most the correspondence gate) and halves each iteration down to it; once the steps become small
-// under a loose kernel it jumps to the final one. A tight kernel from the start would
+// The scale of the robust kernel over the iterations. Without an informed initial guess it starts at four
+// times `robust_kernel_scale` (at most the correspondence gate) and halves each iteration down to it,
+// jumping to the final one once the steps become small; with one it starts at the final scale. A tight kernel from the start would
 // ignore the very residuals a poor initial guess produces; a tight kernel at the end keeps edge
 // correspondences from biasing the solution.
 class KernelSchedule {
  public:
-  explicit KernelSchedule(const RegistrationConfig& config);
+  KernelSchedule(const RegistrationConfig& config, bool informed_guess);
   double scale() const { return scale_; }
   bool isFinal() const { return scale_ == final_; }
   // Moves to the next iteration's scale; returns true when a small step under the final scale ends the
@@ -46,7 +46,8 @@ class KernelSchedule {
   double scale_;
 };
 
-RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess,
+// `informed_guess`: the initial guess comes from a motion model with enough history to trust it.
+RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config);
 
 }  // namespace elo

@@ -71,7 +71,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   if (started_) {
     const double dt = cloud.stamp - last_stamp_;
     stage_start = Clock::now();
-    result.registration = registerScan(*backend_, motion_.predict(dt), config_.registration);
+    result.registration = registerScan(*backend_, motion_.predict(dt), motion_.informed(), config_.registration);
     result.times.registration = millisecondsSince(stage_start);
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;

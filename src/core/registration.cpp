@@ -48,9 +48,11 @@ void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H
   }
 }
 
-KernelSchedule::KernelSchedule(const RegistrationConfig& config)
+KernelSchedule::KernelSchedule(const RegistrationConfig& config, bool informed_guess)
     : final_(config.robust_kernel_scale),
-      scale_(std::min(config.max_correspondence_distance, kStartFactor * config.robust_kernel_scale)) {}
+      scale_(informed_guess ? config.robust_kernel_scale
+                            : std::min(config.max_correspondence_distance,
+                                       kStartFactor * config.robust_kernel_scale)) {}
 
 bool KernelSchedule::advance(bool step_was_small) {
   if (step_was_small) {
@@ -62,11 +64,11 @@ bool KernelSchedule::advance(bool step_was_small) {
   return false;
 }
 
-RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess,
+RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
-  KernelSchedule kernel(config);
+  KernelSchedule kernel(config, informed_guess);
   Vector6d g;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     result.last = backend.linearize(result.model_from_scan, kernel.scale());

@@ -25,6 +25,13 @@ struct LidarOptions {
   // true: the whole sweep is taken at its start pose (no motion distortion); false: each firing from
   // the pose at its own time, as a real spinning sensor does while the vehicle moves.
   bool deskewed = true;
+  // The car the sensor is mounted on, in the sensor frame: beams that meet it return nothing (its
+  // surfaces lie inside min_range). Empty: a sensor floating free.
+  std::vector<Shape> vehicle_body = roofMountedCar();
+
+  // An estate car under a roof-mounted sensor 1.73 m above the road (KITTI's Passat): the rounded
+  // cabin under the sensor, and the lower bonnet and boot that hide the road close in front and behind.
+  static std::vector<Shape> roofMountedCar();
 };
 
 // A sweep with the kind of surface behind each point (tests and statistics; not written out).
@@ -61,12 +68,14 @@ class Lidar {
   std::vector<Return> castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const;
   SimulatedScan addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const;
   bool detected(const Return& result, Rng& rng) const;
+  bool hitsVehicle(const Eigen::Vector3d& direction) const;
 
   SensorConfig sensor_;
   LidarOptions options_;
   std::vector<Eigen::Vector2d> beam_directions_;  // (cos, sin) of each beam's elevation
   std::vector<double> azimuth_cos_;
   std::vector<double> azimuth_sin_;
+  std::vector<bool> hidden_by_vehicle_;  // per firing (step-major, like the returns)
 };
 
 }  // namespace elo::sim

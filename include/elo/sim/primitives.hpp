@@ -44,10 +44,25 @@ struct Ellipsoid {
 
 using Shape = std::variant<OrientedBox, VerticalCylinder, Ellipsoid>;
 
+// Rows of windows on the upright faces of a box, one row a storey. Glass mirrors the beam away, so
+// a window returns no echo and the facade shows holes, as in real scans.
+struct WindowGrid {
+  double storey_height = 3.2;   // m
+  double sill_height = 0.9;     // m from a storey's floor to its windows' bottom
+  double window_height = 1.5;   // m
+  double spacing = 3.0;         // m between window centres along the face
+  double window_width = 1.5;    // m
+};
+
 struct Primitive {
   Shape shape;
   float reflectivity = 0.5f;  // 0..1: the intensity of a return at normal incidence
+  std::optional<WindowGrid> windows;  // boxes only
 };
+
+// The reflectivity a beam meets where it hits `point` (with surface `normal`) of the primitive: its
+// own, or zero on window glass.
+float reflectivityAt(const Primitive& primitive, const Eigen::Vector3d& point, const Eigen::Vector3d& normal);
 
 struct Bounds3 {
   Eigen::Vector3d min;

@@ -46,7 +46,7 @@ void CpuBackend::segmentGround() {
 }
 
 void CpuBackend::estimateNormals() {
-  arena_.execute([&] { cpu::estimateNormals(config_.normals, spherical_, scan_); });
+  arena_.execute([&] { cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_); });
   registration_pixels_ = registrationPixels(scan_);
 }
 

@@ -25,7 +25,119 @@ struct Window {
   int half_height;
 };
 
+// Sums over the segments of a window, written as masked arithmetic over plain arrays so that the
+// compiler turns each segment into a few vector instructions: a neighbour is usable (non-ground) and
+// inside the window, then near (test 1) and on the plane (test 2). Each quantity is summed per lane and
+// the lanes are added only once, in a fixed order: a float sum across lanes per segment would have to
+// be done one lane at a time (float addition is not associative), which cost more than the arithmetic.
+class WindowSums {
+ public:
+  static constexpr int kLanes = 16;
+
+  WindowSums(const Vec3f& centre, float distant_squared, const Vec3f& plane, float plane_distance)
+      : centre_(centre), distant_squared_(distant_squared), plane_(plane), plane_distance_(plane_distance) {}
+
+  void addSegment(const NormalScratch& planes, size_t start, const float* __restrict window) {
+    for (int base = 0; base < planes.span; base += kLanes) addLanes(planes, start + base, window + base);
+  }
+
+  int neighbours() const { return static_cast<int>(total(kNeighbours)); }
+  int distant() const { return static_cast<int>(total(kDistant)); }
+
+  PointMoments moments() const {
+    PointMoments m;
+    m.sum << total(kSx), total(kSy), total(kSz);
+    const float sxy = total(kSxy);
+    const float sxz = total(kSxz);
+    const float syz = total(kSyz);
+    m.outer << total(kSxx), sxy, sxz, sxy, total(kSyy), syz, sxz, syz, total(kSzz);
+    m.count = static_cast<int>(total(kCount));
+    return m;
+  }
+
+ private:
+  enum Quantity { kNeighbours, kDistant, kCount, kSx, kSy, kSz, kSxx, kSxy, kSxz, kSyy, kSyz, kSzz, kQuantities };
+
+  void addLanes(const NormalScratch& planes, size_t start, const float* __restrict window) {
+    const float* __restrict x = planes.x.data() + start;
+    const float* __restrict y = planes.y.data() + start;
+    const float* __restrict z = planes.z.data() + start;
+    const float* __restrict usable = planes.usable.data() + start;
+    for (int i = 0; i < kLanes; ++i) {
+      const float dx = x[i] - centre_.x();
+      const float dy = y[i] - centre_.y();
+      const float dz = z[i] - centre_.z();
+      const float present = usable[i] * window[i];
+      const float far = present * static_cast<float>(dx * dx + dy * dy + dz * dz > distant_squared_);
+      const float off_plane = static_cast<float>(std::abs(dx * plane_.x() + dy * plane_.y() + dz * plane_.z()) >
+                                                 plane_distance_);
+      const float kept = (present - far) * (1.0f - off_plane);
+      lanes_[kNeighbours][i] += present;
+      lanes_[kDistant][i] += far;
+      lanes_[kCount][i] += kept;
+      lanes_[kSx][i] += kept * dx;
+      lanes_[kSy][i] += kept * dy;
+      lanes_[kSz][i] += kept * dz;
+      lanes_[kSxx][i] += kept * dx * dx;
+      lanes_[kSxy][i] += kept * dx * dy;
+      lanes_[kSxz][i] += kept * dx * dz;
+      lanes_[kSyy][i] += kept * dy * dy;
+      lanes_[kSyz][i] += kept * dy * dz;
+      lanes_[kSzz][i] += kept * dz * dz;
+    }
+  }
+
+  // Pairwise over the lanes, always in the same order.
+  float total(Quantity quantity) const {
+    float lanes[kLanes];
+    for (int i = 0; i < kLanes; ++i) lanes[i] = lanes_[quantity][i];
+    for (int width = kLanes / 2; width > 0; width /= 2) {
+      for (int i = 0; i < width; ++i) lanes[i] += lanes[i + width];
+    }
+    return lanes[0];
+  }
+
+  Vec3f centre_;
+  float distant_squared_;
+  Vec3f plane_;
+  float plane_distance_;
+  alignas(64) float lanes_[kQuantities][kLanes] = {};
+};
+
 }  // namespace
+
+void NormalScratch::fill(const ScanImage& scan, int max_window_width) {
+  const int rows = scan.image.rows;
+  const int cols = scan.image.cols;
+  span = 16 * ((max_window_width + 15) / 16);
+  stride = cols + span;
+  const size_t size = static_cast<size_t>(rows) * stride;
+  x.resize(size);
+  y.resize(size);
+  z.resize(size);
+  usable.resize(size);
+  const int pad = span / 2;
+  parallelFor(static_cast<size_t>(rows), [&](size_t row) {
+    for (int padded = 0; padded < stride; ++padded) {
+      const int col = (padded - pad + cols) % cols;
+      const size_t pixel = row * cols + col;
+      // Other pixels keep stale vertices; zeros keep them out of the masked sums (0 * NaN would not).
+      const bool is_usable = scan.label[pixel] == PixelLabel::nonground;
+      const Vec3f v = is_usable ? scan.image.vertex[pixel] : Vec3f::Zero();
+      const size_t at = row * stride + padded;
+      x[at] = v.x();
+      y[at] = v.y();
+      z[at] = v.z();
+      usable[at] = is_usable ? 1.0f : 0.0f;
+    }
+  });
+  window_mask.assign(static_cast<size_t>(pad + 1) * span, 0.0f);
+  for (int half = 0; half <= pad; ++half) {
+    for (int lane = 0; lane < span; ++lane) {
+      window_mask[static_cast<size_t>(half) * span + lane] = std::abs(lane - pad) <= half ? 1.0f : 0.0f;
+    }
+  }
+}
 
 WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range) {
   const double width = config.search_size / (range * M_PI) * projection.cols;
@@ -38,8 +150,9 @@ namespace {
 
 class NormalEstimator {
  public:
-  NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan)
-      : config_(config), projection_(projection), scan_(scan), image_(scan.image) {}
+  NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, const NormalScratch& planes,
+                  ScanImage& scan)
+      : config_(config), projection_(projection), planes_(planes), scan_(scan), image_(scan.image) {}
 
   void estimate(size_t pixel) const {
     if (scan_.label[pixel] != PixelLabel::nonground) return;
@@ -91,30 +204,16 @@ class NormalEstimator {
     const int cols = projection_.cols;
     const int row = static_cast<int>(pixel) / cols;
     const int col = static_cast<int>(pixel) % cols;
-    const Vec3f& centre = image_.vertex[pixel];
-    const float distant_squared = static_cast<float>(config_.outlier_distance * config_.outlier_distance);
-    const float plane_distance = static_cast<float>(config_.plane_distance);
-    int neighbours = 0;
-    int distant = 0;
+    WindowSums sums(image_.vertex[pixel],
+                    reject_distant ? static_cast<float>(config_.outlier_distance * config_.outlier_distance) : INFINITY,
+                    plane ? *plane : Vec3f::Zero(), plane ? static_cast<float>(config_.plane_distance) : INFINITY);
+    const float* mask = planes_.window_mask.data() + static_cast<size_t>(window.half_width) * planes_.span;
     for (int r = std::max(0, row - window.half_height); r <= std::min(projection_.rows - 1, row + window.half_height);
          ++r) {
-      const size_t row_start = static_cast<size_t>(r) * cols;
-      for (int dc = -window.half_width; dc <= window.half_width; ++dc) {
-        int c = col + dc;
-        c += c < 0 ? cols : (c >= cols ? -cols : 0);  // azimuth is circular
-        const size_t neighbour = row_start + c;
-        if (scan_.label[neighbour] != PixelLabel::nonground) continue;
-        const Vec3f offset = image_.vertex[neighbour] - centre;
-        ++neighbours;
-        if (reject_distant && offset.squaredNorm() > distant_squared) {
-          ++distant;
-          continue;
-        }
-        if (plane && std::abs(offset.dot(*plane)) > plane_distance) continue;
-        moments.add(offset);
-      }
+      sums.addSegment(planes_, planes_.segmentStart(r, col), mask);
     }
-    return 2 * distant <= neighbours - 1;  // the centre is not its own neighbour
+    moments = sums.moments();
+    return 2 * sums.distant() <= sums.neighbours() - 1;  // the centre is not its own neighbour
   }
 
   PlaneFit fitEnough(const PointMoments& moments) const {
@@ -152,14 +251,17 @@ class NormalEstimator {
 
   const NormalConfig& config_;
   const SphericalProjection& projection_;
+  const NormalScratch& planes_;
   ScanImage& scan_;
   SphericalImage& image_;
 };
 
 }  // namespace
 
-void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan) {
-  const NormalEstimator estimator(config, projection, scan);
+void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, NormalScratch& scratch,
+                     ScanImage& scan) {
+  scratch.fill(scan, config.max_window_width);
+  const NormalEstimator estimator(config, projection, scratch, scan);
   parallelFor(scan.image.pixelCount(), [&](size_t pixel) { estimator.estimate(pixel); });
 }
 

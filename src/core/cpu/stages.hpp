@@ -29,7 +29,24 @@ struct WindowSize {
 };
 // The range-adaptive window of Eq. 12 for a point at `range`.
 WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range);
-void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, ScanImage& scan);
+// The non-ground image as separate coordinate planes and a 0/1 mask, so that the window loops of the
+// normal estimator run over plain float arrays and vectorise. Each row is padded on both sides with the
+// columns of its other end (azimuth is circular), so every window row is one contiguous segment of
+// `span` pixels (a multiple of 16) centred on the pixel. Kept by the backend to reuse its memory.
+struct NormalScratch {
+  int span = 0;    // segment length: the widest window rounded up to 16 lanes
+  int stride = 0;  // cols + span
+  std::vector<float> x, y, z;
+  std::vector<float> usable;  // 1 for a non-ground pixel, else 0
+  std::vector<float> window_mask;  // per half-width h: span lanes, 1 where |lane - span/2| <= h
+
+  void fill(const ScanImage& scan, int max_window_width);
+  size_t segmentStart(int row, int col) const {  // first element of the segment centred on (row, col)
+    return static_cast<size_t>(row) * stride + col;
+  }
+};
+void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, NormalScratch& scratch,
+                     ScanImage& scan);
 
 // bev_map.cpp: the BEV map of the ground pixels, closest point per cell.
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground);
