@@ -11,9 +11,30 @@ namespace elo::cpu {
 
 namespace {
 
-// Below this middle eigenvalue (1 cm spread across the line) the points lie on one scan ring and the
-// plane through them could turn about it freely.
-constexpr double kMinCrossSpread = 1e-4;
+// Below this smallest eigenvalue of their horizontal spread (1 cm across the line) the points lie on one
+// scan ring and the plane through them could turn about it freely.
+constexpr float kMinCrossSpread = 1e-4f;
+
+// The upward normal of the plane z = a x + b y + c fitted to `points` by least squares (a ground patch
+// is never vertical, so this 2x2 solve replaces an eigen-decomposition), or zero when the points are
+// (nearly) collinear in x-y.
+Vec3f groundPlaneNormal(const Vec3f* points, int count, const Vec3f& origin) {
+  if (count < 3) return Vec3f::Zero();
+  PointMoments moments;
+  for (int i = 0; i < count; ++i) moments.add(points[i] - origin);
+  const Vec3f mean = moments.sum / static_cast<float>(count);
+  const Eigen::Matrix3f covariance = moments.outer / static_cast<float>(count) - mean * mean.transpose();
+  const float cxx = covariance(0, 0);
+  const float cxy = covariance(0, 1);
+  const float cyy = covariance(1, 1);
+  const float determinant = cxx * cyy - cxy * cxy;
+  const float half_trace = 0.5f * (cxx + cyy);
+  const float smallest_spread = half_trace - std::sqrt(std::max(half_trace * half_trace - determinant, 0.0f));
+  if (!(smallest_spread >= kMinCrossSpread)) return Vec3f::Zero();
+  const float a = (cyy * covariance(0, 2) - cxy * covariance(1, 2)) / determinant;
+  const float b = (cxx * covariance(1, 2) - cxy * covariance(0, 2)) / determinant;
+  return Vec3f(-a, -b, 1.0f).normalized();
+}
 // Upper bound of bev.normal_neighbours honoured by the fixed-size buffers of the fit.
 constexpr int kMaxNormalNeighbours = 32;
 
@@ -93,11 +114,7 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
     }
   }
 
-  Vec3f normal = Vec3f::Zero();
-  const PlaneFit fit = fitPlane(points.data(), used, centre);
-  if (fit.valid && fit.middle_eigenvalue >= kMinCrossSpread) {
-    normal = fit.normal.z() < 0.0f ? Vec3f(-fit.normal) : fit.normal;  // ground normals point up
-  }
+  const Vec3f normal = groundPlaneNormal(points.data(), used, centre);
   uint8_t expected = unknown;
   if (states_[point].compare_exchange_strong(expected, fitting, std::memory_order_acq_rel)) {
     normals_[point] = normal;

@@ -10,7 +10,6 @@ namespace elo::cpu {
 struct PlaneFit {
   Vec3f normal = Vec3f::Zero();  // eigenvector of the smallest eigenvalue
   float curvature = 1.0f;        // lambda3 / (lambda1 + lambda2 + lambda3)
-  double middle_eigenvalue = 0.0;  // lambda2: near zero when the points lie on a line
   bool valid = false;
 };
 
@@ -41,17 +40,8 @@ inline PlaneFit fitPlane(const PointMoments& moments) {
   if (!(sum > 0.0f)) return fit;
   fit.normal = solver.eigenvectors().col(0).normalized();
   fit.curvature = std::max(eigenvalues(0), 0.0f) / sum;
-  fit.middle_eigenvalue = eigenvalues(1);
   fit.valid = fit.normal.allFinite();
   return fit;
-}
-
-// `points[0..count)` are taken relative to `origin` so that float coordinates far from the sensor keep
-// their precision.
-inline PlaneFit fitPlane(const Vec3f* points, int count, const Vec3f& origin) {
-  PointMoments moments;
-  for (int i = 0; i < count; ++i) moments.add(points[i] - origin);
-  return fitPlane(moments);
 }
 
 }  // namespace elo::cpu
