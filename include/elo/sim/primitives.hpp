@@ -55,8 +55,11 @@ struct WindowGrid {
 };
 
 struct Primitive {
+  Primitive(Shape shape_, float reflectivity_, std::optional<WindowGrid> windows_ = std::nullopt)
+      : shape(std::move(shape_)), reflectivity(reflectivity_), windows(windows_) {}
+
   Shape shape;
-  float reflectivity = 0.5f;  // 0..1: the intensity of a return at normal incidence
+  float reflectivity;                 // 0..1: the intensity of a return at normal incidence
   std::optional<WindowGrid> windows;  // boxes only
 };
 

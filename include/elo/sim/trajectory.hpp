@@ -51,8 +51,9 @@ std::optional<TrajectoryKind> trajectoryKindFromName(const std::string& name);
 std::string trajectoryName(TrajectoryKind kind);
 std::vector<std::string> trajectoryNames();
 
-// A drive of `duration` seconds at `cruise_speed` (m/s) along the kind's road, slowing for turns to a
-// comfortable lateral acceleration, and stopping for a few seconds every ~150 m in stop-and-go.
+// A drive of `duration` seconds along the kind's road: from rest up to `cruise_speed` (m/s), slowing
+// for turns to a comfortable lateral acceleration, and stopping for a few seconds every ~150 m in
+// stop-and-go.
 Route proceduralRoute(TrajectoryKind kind, double cruise_speed, double duration);
 
 // A drive through given LiDAR-frame poses, one per frame `frame_period` apart: x, y and heading are

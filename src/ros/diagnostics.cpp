@@ -1,0 +1,103 @@
+#include "diagnostics.hpp"
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+
+#include <algorithm>
+#include <sstream>
+
+namespace elo_ros {
+namespace {
+
+double mean(double sum, size_t count) { return count > 0 ? sum / count : 0.0; }
+
+}  // namespace
+
+std::string PipelineStatistics::Window::problems() const {
+  if (received == 0 && processed == 0) return "no clouds received";
+  std::ostringstream text;
+  const auto add = [&](size_t count, const char* what) {
+    if (count > 0) text << (text.tellp() > 0 ? ", " : "") << count << ' ' << what;
+  };
+  add(dropped, "dropped (processing slower than input)");
+  add(rejected, "rejected");
+  add(skipped, "skipped");
+  add(failed_registrations, "registrations failed");
+  return text.str();
+}
+
+PipelineStatistics::PipelineStatistics() : window_start_(Clock::now()) {}
+
+void PipelineStatistics::cloudReceived() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++received_;
+  ++window_.received;
+}
+
+void PipelineStatistics::cloudsDropped(size_t count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  dropped_ += count;
+  window_.dropped += count;
+}
+
+void PipelineStatistics::cloudRejected(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++rejected_[reason];
+  ++window_.rejected;
+}
+
+void PipelineStatistics::scanSkipped(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++skipped_[reason];
+  ++window_.skipped;
+}
+
+void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double latency_ms) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++processed_;
+  ++window_.processed;
+  window_.processing_ms_sum += result.times.total;
+  window_.processing_ms_max = std::max(window_.processing_ms_max, result.times.total);
+  window_.latency_ms_sum += latency_ms;
+  window_.latency_ms_max = std::max(window_.latency_ms_max, latency_ms);
+  if (result.registration.failed) {
+    ++failed_registrations_;
+    ++window_.failed_registrations;
+  }
+  if (result.registration.iterations > 0) last_registration_ = result.registration;
+}
+
+void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Clock::time_point now = Clock::now();
+  const double seconds = std::chrono::duration<double>(now - window_start_).count();
+  const Window& w = window_;
+
+  const std::string problems = w.problems();
+  if (problems.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, problems);
+  }
+  status.add("input rate (Hz)", seconds > 0.0 ? w.received / seconds : 0.0);
+  status.add("processing rate (Hz)", seconds > 0.0 ? w.processed / seconds : 0.0);
+  status.add("processing time mean (ms)", mean(w.processing_ms_sum, w.processed));
+  status.add("processing time max (ms)", w.processing_ms_max);
+  status.add("latency mean (ms)", mean(w.latency_ms_sum, w.processed));
+  status.add("latency max (ms)", w.latency_ms_max);
+  const elo::NormalEquations& last = last_registration_.last;
+  status.add("non-ground inlier ratio", last.nonground.inlierRatio());
+  status.add("ground inlier ratio", last.ground.inlierRatio());
+  status.add("fusion weight", last_registration_.weight);
+  status.add("registration iterations", last_registration_.iterations);
+  status.add("clouds received", received_);
+  status.add("scans processed", processed_);
+  status.add("scans dropped", dropped_);
+  status.add("registrations failed", failed_registrations_);
+  for (const auto& [reason, count] : rejected_) status.add("clouds rejected: " + reason, count);
+  for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
+
+  window_start_ = now;
+  window_ = Window();
+}
+
+}  // namespace elo_ros

@@ -1,0 +1,65 @@
+// What the node has done with the clouds it received, for diagnostic_updater: totals since the start,
+// and rates and timings over the window since the previous report.
+#pragma once
+
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "elo/odometry.hpp"
+
+namespace elo_ros {
+
+class PipelineStatistics {
+ public:
+  PipelineStatistics();
+
+  void cloudReceived();
+  // Clouds that waited for the worker and a newer one replaced (latest-scan mode).
+  void cloudsDropped(size_t count);
+  // The cloud could not be converted or placed (see cloud_conversion.hpp); `reason` groups the counts.
+  void cloudRejected(const std::string& reason);
+  // The core skipped the scan (elo::FrameResult::skip_reason).
+  void scanSkipped(const std::string& reason);
+  // `latency_ms`: from the cloud's arrival to its odometry being published, queueing included.
+  void scanProcessed(const elo::FrameResult& result, double latency_ms);
+
+  // Fills `status` and starts a new window. WARN when the window saw no cloud at all, or a drop,
+  // rejection, skip or failed registration.
+  void report(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  struct Window {
+    size_t received = 0;
+    size_t processed = 0;
+    size_t dropped = 0;
+    size_t rejected = 0;
+    size_t skipped = 0;
+    size_t failed_registrations = 0;
+    double processing_ms_sum = 0.0;
+    double processing_ms_max = 0.0;
+    double latency_ms_sum = 0.0;
+    double latency_ms_max = 0.0;
+
+    // Why the window deserves a warning; empty when it does not.
+    std::string problems() const;
+  };
+
+  std::mutex mutex_;
+  Clock::time_point window_start_;
+  Window window_;
+  size_t received_ = 0;
+  size_t processed_ = 0;
+  size_t dropped_ = 0;
+  size_t failed_registrations_ = 0;
+  std::map<std::string, size_t> rejected_;
+  std::map<std::string, size_t> skipped_;
+  elo::RegistrationResult last_registration_;
+};
+
+}  // namespace elo_ros

@@ -1,0 +1,302 @@
+#include "odometry_nodelet.hpp"
+
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "cloud_conversion.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/io/pcd.hpp"
+
+namespace elo_ros {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kWarningPeriod = 5.0;  // s between repeats of one throttled warning
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+}  // namespace
+
+void OdometryNodelet::onInit() {
+  try {
+    settings_ = readNodeSettings(getPrivateNodeHandle());
+    odometry_ = std::make_unique<elo::Odometry>(loadConfig());
+  } catch (const std::exception& error) {
+    NODELET_FATAL("cannot start: %s", error.what());
+    throw;
+  }
+  if (!settings_.publish_sensor_frame_directly) {
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, getNodeHandle());
+  }
+  tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  advertise();
+
+  diagnostics_ = std::make_unique<diagnostic_updater::Updater>(getNodeHandle(), getPrivateNodeHandle(), getName());
+  diagnostics_->setHardwareID(odometry_->config().sensor.name);
+  diagnostics_->add("odometry", &statistics_, &PipelineStatistics::report);
+  // A wall timer: diagnostics must keep coming while a replayed clock is paused or not yet started.
+  diagnostics_timer_ = getNodeHandle().createWallTimer(ros::WallDuration(1.0),
+                                                       [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
+
+  // 0: every scan is queued (bag replay); 1: only the latest waits, older ones are dropped and counted.
+  queue_ = std::make_unique<ScanQueue>(settings_.process_every_scan ? 0 : 1);
+  worker_ = std::thread([this] { runWorker(); });
+  // roscpp's own queue stays unbounded when every scan counts; the callback empties it at once anyway.
+  const uint32_t subscriber_queue = settings_.process_every_scan ? 0 : 5;
+  cloud_subscriber_ = getNodeHandle().subscribe("points", subscriber_queue, &OdometryNodelet::onCloud, this);
+
+  const elo::Config& config = odometry_->config();
+  NODELET_INFO("ELO odometry on %s: sensor %s, %s backend, %d threads (0 = all), %s, %s; publishing %s -> %s",
+               cloud_subscriber_.getTopic().c_str(), config.sensor.name.c_str(), odometry_->backend().name(),
+               config.runtime.threads,
+               config.model.mode == elo::RegistrationMode::frame_to_model ? "frame-to-model" : "frame-to-frame",
+               settings_.process_every_scan ? "every scan processed" : "latest scan processed",
+               settings_.odom_frame.c_str(),
+               settings_.publish_sensor_frame_directly ? "<sensor frame>" : settings_.base_frame.c_str());
+}
+
+elo::Config OdometryNodelet::loadConfig() {
+  ros::NodeHandle& private_node = getPrivateNodeHandle();
+  XmlRpc::XmlRpcValue tree;
+  private_node.getParam(private_node.getNamespace(), tree);
+  elo::Config config;
+  const std::vector<std::string> unknown = applyConfigParameters(tree, config);
+  if (!unknown.empty()) {
+    NODELET_WARN("unknown parameters ignored (no such odometry parameter, see config/*.yaml): %s",
+                 joined(unknown).c_str());
+  }
+  elo::validate(config);
+  for (const auto& [name, value] : effectiveParameters(config)) private_node.setParam(name, value);
+  return config;
+}
+
+void OdometryNodelet::advertise() {
+  ros::NodeHandle& node = getNodeHandle();
+  odometry_publisher_ = node.advertise<nav_msgs::Odometry>("odom", 100);
+  path_publisher_ = node.advertise<nav_msgs::Path>("path", 1);
+  model_nonground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("model/nonground", 1);
+  model_ground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("model/ground", 1);
+  scan_ground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("scan/ground", 1);
+  scan_nonground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("scan/nonground", 1);
+  ros::NodeHandle& private_node = getPrivateNodeHandle();
+  reset_service_ = private_node.advertiseService("reset", &OdometryNodelet::onReset, this);
+  save_trajectory_service_ = private_node.advertiseService("save_trajectory", &OdometryNodelet::onSaveTrajectory, this);
+  save_map_service_ = private_node.advertiseService("save_map", &OdometryNodelet::onSaveMap, this);
+}
+
+OdometryNodelet::~OdometryNodelet() {
+  if (!queue_) return;  // onInit failed: nothing started
+  cloud_subscriber_.shutdown();
+  diagnostics_timer_.stop();
+  const size_t waiting = queue_->size();
+  if (waiting > 0) NODELET_INFO("finishing %zu queued scans before stopping", waiting);
+  queue_->close();
+  worker_.join();
+  if (!settings_.save_trajectory_on_shutdown) return;
+  try {
+    NODELET_INFO("%s", saveTrajectory(settings_.outputs).c_str());
+  } catch (const std::exception& error) {
+    NODELET_ERROR("cannot save the trajectory on shutdown: %s", error.what());
+  }
+}
+
+void OdometryNodelet::onCloud(const sensor_msgs::PointCloud2ConstPtr& message) {
+  statistics_.cloudReceived();
+  const size_t dropped = queue_->push({message, Clock::now()});
+  if (dropped > 0) {
+    statistics_.cloudsDropped(dropped);
+    NODELET_WARN_THROTTLE(kWarningPeriod,
+                          "processing is slower than the input: older scans dropped (set ~process_every_scan "
+                          "to queue every scan instead)");
+  }
+}
+
+void OdometryNodelet::runWorker() {
+  while (const std::optional<QueuedCloud> queued = queue_->pop()) processCloud(*queued);
+}
+
+void OdometryNodelet::reject(const std::string& reason, const std::string& detail) {
+  statistics_.cloudRejected(reason);
+  NODELET_WARN_THROTTLE(kWarningPeriod, "cloud ignored: %s", detail.c_str());
+}
+
+bool OdometryNodelet::bindFrames(const std::string& sensor_frame) {
+  if (frames_) {
+    if (frames_->sensor_frame == sensor_frame) return true;
+    reject("sensor frame changed",
+           "frame '" + sensor_frame + "' differs from the first cloud's frame '" + frames_->sensor_frame + "'");
+    return false;
+  }
+  FrameBinding frames{settings_.odom_frame, sensor_frame, settings_.base_frame, Eigen::Isometry3d::Identity()};
+  if (settings_.publish_sensor_frame_directly) {
+    frames.child_frame = sensor_frame;
+  } else if (sensor_frame != settings_.base_frame) {
+    try {
+      frames.base_from_sensor = tf2::transformToEigen(tf_buffer_->lookupTransform(
+          settings_.base_frame, sensor_frame, ros::Time(0), ros::Duration(settings_.tf_timeout)));
+    } catch (const tf2::TransformException& error) {
+      reject("no sensor -> base transform",
+             "no transform " + settings_.base_frame + " <- " + sensor_frame + " (" + error.what() +
+                 "); publish it, or set ~publish_sensor_frame_directly when there is no " + settings_.base_frame);
+      return false;
+    }
+  }
+  // The extrinsic is fixed: the listener has done its work.
+  tf_listener_.reset();
+  tf_buffer_.reset();
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  frames_ = frames;
+  return true;
+}
+
+void OdometryNodelet::processCloud(const QueuedCloud& queued) {
+  const sensor_msgs::PointCloud2& message = *queued.message;
+  const ConvertedCloud converted = fromPointCloud2(message);
+  if (!converted.usable()) {
+    reject(describe(converted.problem), converted.detail);
+    return;
+  }
+  if (!bindFrames(message.header.frame_id)) return;
+
+  std::unique_lock<std::mutex> lock(odometry_mutex_);
+  const elo::FrameResult result = odometry_->process(converted.cloud);
+  if (result.reset) {
+    NODELET_WARN("time went backwards (a bag replayed again?): the odometry restarted");
+    forgetTrajectory();
+  }
+  // Every scan the core saw, a skipped one repeating the last pose: the lines match elo_run's.
+  trajectory_stamps_.push_back(converted.cloud.stamp);
+  trajectory_poses_.push_back(result.pose);
+  if (!result.processed) {
+    lock.unlock();
+    statistics_.scanSkipped(result.skip_reason);
+    NODELET_WARN_THROTTLE(kWarningPeriod, "scan skipped: %s", result.skip_reason.c_str());
+    return;
+  }
+  const double dt = last_processed_stamp_ ? converted.cloud.stamp - *last_processed_stamp_ : 0.0;
+  last_processed_stamp_ = converted.cloud.stamp;
+  std_msgs::Header header;
+  header.stamp = message.header.stamp;
+  header.frame_id = frames_->sensor_frame;
+  const ScanMessages messages = buildMessages(result, dt, header);
+  lock.unlock();
+
+  // After ros::shutdown the node only finishes its queue (for the trajectory): there is no one to tell.
+  if (ros::ok()) publish(messages);
+  const double latency_ms = std::chrono::duration<double, std::milli>(Clock::now() - queued.received).count();
+  statistics_.scanProcessed(result, latency_ms);
+}
+
+OdometryNodelet::ScanMessages OdometryNodelet::buildMessages(const elo::FrameResult& result, double dt,
+                                                             const std_msgs::Header& header) {
+  ScanMessages messages;
+  messages.odometry = odometryMessage(result, dt, *frames_, header.stamp);
+
+  geometry_msgs::PoseStamped pose;
+  pose.header = messages.odometry.header;
+  pose.pose = messages.odometry.pose.pose;
+  path_.push_back(pose);
+  if (settings_.path_length > 0 && path_.size() > static_cast<size_t>(settings_.path_length)) path_.pop_front();
+  if (path_publisher_.getNumSubscribers() > 0) {
+    messages.path.emplace();
+    messages.path->header = messages.odometry.header;
+    messages.path->poses.assign(path_.begin(), path_.end());
+  }
+
+  // The models are large; they go out at most model_publish_rate times per second of scan time.
+  const double stamp = header.stamp.toSec();
+  const bool models_wanted =
+      model_nonground_publisher_.getNumSubscribers() > 0 || model_ground_publisher_.getNumSubscribers() > 0;
+  if (settings_.model_publish_rate > 0.0 && models_wanted && stamp >= next_model_stamp_) {
+    next_model_stamp_ = stamp + 1.0 / settings_.model_publish_rate;
+    const elo::Model& model = odometry_->backend().model();
+    messages.model_nonground = nonGroundModelCloud(model.nonground, header);
+    messages.model_ground = groundModelCloud(model.ground, header);
+  }
+  if (scan_ground_publisher_.getNumSubscribers() > 0) {
+    messages.scan_ground = labelledScanCloud(odometry_->backend().scan(), elo::PixelLabel::ground, header);
+  }
+  if (scan_nonground_publisher_.getNumSubscribers() > 0) {
+    messages.scan_nonground = labelledScanCloud(odometry_->backend().scan(), elo::PixelLabel::nonground, header);
+  }
+  return messages;
+}
+
+void OdometryNodelet::publish(const ScanMessages& messages) {
+  odometry_publisher_.publish(messages.odometry);
+  if (settings_.publish_tf) tf_broadcaster_->sendTransform(odometryTransform(messages.odometry));
+  if (messages.path) path_publisher_.publish(*messages.path);
+  if (messages.model_nonground) model_nonground_publisher_.publish(*messages.model_nonground);
+  if (messages.model_ground) model_ground_publisher_.publish(*messages.model_ground);
+  if (messages.scan_ground) scan_ground_publisher_.publish(*messages.scan_ground);
+  if (messages.scan_nonground) scan_nonground_publisher_.publish(*messages.scan_nonground);
+}
+
+void OdometryNodelet::forgetTrajectory() {
+  trajectory_stamps_.clear();
+  trajectory_poses_.clear();
+  path_.clear();
+  last_processed_stamp_.reset();
+  next_model_stamp_ = -std::numeric_limits<double>::infinity();
+}
+
+bool OdometryNodelet::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  odometry_->reset();
+  forgetTrajectory();
+  response.success = true;
+  response.message = "odometry reset: the next scan starts a new trajectory at the origin";
+  NODELET_INFO("%s", response.message.c_str());
+  return true;
+}
+
+std::string OdometryNodelet::saveTrajectory(const OutputFiles& files) {
+  if (files.trajectory_file.empty()) throw std::invalid_argument("~trajectory_file is not set");
+  const TrajectoryFormat format = parseTrajectoryFormat(files.trajectory_format);
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  if (format == TrajectoryFormat::kitti) {
+    elo::writeKittiPoses(files.trajectory_file, trajectory_poses_);
+  } else {
+    elo::writeTumPoses(files.trajectory_file, trajectory_stamps_, trajectory_poses_);
+  }
+  return "wrote " + std::to_string(trajectory_poses_.size()) + " sensor poses (" + files.trajectory_format +
+         ") to " + files.trajectory_file;
+}
+
+bool OdometryNodelet::onSaveTrajectory(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  try {
+    response.message = saveTrajectory(readOutputFiles(getPrivateNodeHandle()));
+    response.success = true;
+  } catch (const std::exception& error) {
+    response.message = error.what();
+    response.success = false;
+  }
+  return true;
+}
+
+bool OdometryNodelet::onSaveMap(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  try {
+    const OutputFiles files = readOutputFiles(getPrivateNodeHandle());
+    if (files.map_file.empty()) throw std::invalid_argument("~map_file is not set");
+    std::lock_guard<std::mutex> lock(odometry_mutex_);
+    if (!frames_ || !last_processed_stamp_) throw std::runtime_error("no scan processed yet: the model is empty");
+    // The model lives in the latest scan's frame; the file holds it in the odom frame.
+    const elo::PointCloud map =
+        modelPoints(odometry_->backend().model(), frames_->sensorPose(odometry_->pose()));
+    elo::writePcd(files.map_file, map);
+    response.message = "wrote " + std::to_string(map.size()) + " model points (" + settings_.odom_frame +
+                       " frame) to " + files.map_file;
+    response.success = true;
+  } catch (const std::exception& error) {
+    response.message = error.what();
+    response.success = false;
+  }
+  return true;
+}
+
+}  // namespace elo_ros

@@ -1,0 +1,127 @@
+#include "elo/sim/lidar.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "elo/sensor_model.hpp"
+#include "elo/sim/rng.hpp"
+
+namespace elo::sim {
+namespace {
+constexpr double kEchoReferenceRange = 10.0;  // m at which the echo strength equals the intensity
+}  // namespace
+
+std::vector<Shape> LidarOptions::roofMountedCar() {
+  // 4.8 m x 1.8 m with bonnet and boot 1.0 m above the road; the roof 1.33 m above the road, rounded
+  // at its edges, so that the lowest beams clear it sideways as they do on KITTI's car.
+  constexpr double kRoad = -1.73;
+  const Ellipsoid cabin{Eigen::Vector3d(-0.2, 0.0, kRoad + 0.88), Eigen::Vector3d(1.3, 0.75, 0.45), 0.0};
+  const OrientedBox body{Eigen::Vector3d(0.0, 0.0, kRoad + 0.65), Eigen::Matrix3d::Identity(),
+                         Eigen::Vector3d(2.4, 0.9, 0.35)};
+  return {cabin, body};
+}
+
+Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options) : sensor_(sensor), options_(options) {
+  if (sensor.azimuth_steps <= 0 || sensor.rotation_rate_hz <= 0.0 || sensor.max_range <= sensor.min_range) {
+    throw std::invalid_argument("sensor '" + sensor.name + "': azimuth_steps, rotation_rate_hz and the range "
+                                "limits must describe a working sensor");
+  }
+  if (options.dropout_probability < 0.0 || options.dropout_probability > 1.0) {
+    throw std::invalid_argument("dropout probability must lie in [0, 1]");
+  }
+  if (options.detection_threshold < 0.0) throw std::invalid_argument("detection threshold must not be negative");
+  for (const float elevation : beamElevations(sensor)) {
+    beam_directions_.emplace_back(std::cos(static_cast<double>(elevation)), std::sin(static_cast<double>(elevation)));
+  }
+  if (beam_directions_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");
+  // The head turns clockwise seen from above (as Velodyne and Ouster sensors do), starting behind
+  // the vehicle: azimuth pi - 2 pi k / N, so that time grows with the range image's column.
+  for (int step = 0; step < sensor.azimuth_steps; ++step) {
+    const double azimuth = M_PI - 2.0 * M_PI * step / sensor.azimuth_steps;
+    azimuth_cos_.push_back(std::cos(azimuth));
+    azimuth_sin_.push_back(std::sin(azimuth));
+  }
+  for (int step = 0; step < sensor.azimuth_steps; ++step) {
+    for (int beam = 0; beam < beamCount(); ++beam) hidden_by_vehicle_.push_back(hitsVehicle(direction(beam, step)));
+  }
+}
+
+Eigen::Vector3d Lidar::direction(int beam, int step) const {
+  const Eigen::Vector2d& elevation = beam_directions_[beam];
+  return Eigen::Vector3d(elevation.x() * azimuth_cos_[step], elevation.x() * azimuth_sin_[step], elevation.y());
+}
+
+SimulatedScan Lidar::sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
+                           double stamp, uint64_t seed) const {
+  std::vector<Eigen::Isometry3d> poses;
+  if (options_.deskewed) {
+    poses.assign(1, sensor_pose_at(stamp));
+  } else {
+    poses.reserve(azimuthSteps());
+    for (int step = 0; step < azimuthSteps(); ++step) poses.push_back(sensor_pose_at(stamp + firingTime(step)));
+  }
+  return addNoise(castAll(scene, poses), stamp, seed);
+}
+
+std::vector<Lidar::Return> Lidar::castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const {
+  const int beams = beamCount();
+  std::vector<Return> returns(static_cast<size_t>(beams) * azimuthSteps());
+  // Geometry only: exact, independent per ray, so the order the threads take them in does not matter.
+  tbb::parallel_for(0, beams, [&](int beam) {
+    for (int step = 0; step < azimuthSteps(); ++step) {
+      const Eigen::Isometry3d& pose = poses.size() == 1 ? poses.front() : poses[step];
+      if (hidden_by_vehicle_[static_cast<size_t>(step) * beams + beam]) continue;
+      const Eigen::Vector3d local = direction(beam, step);
+      const Ray ray{pose.translation(), pose.linear() * local};
+      const auto hit = scene.cast(ray, sensor_.max_range);
+      if (!hit || hit->reflectivity <= 0.0f) continue;  // sky, or glass that mirrors the beam away
+      Return& result = returns[static_cast<size_t>(step) * beams + beam];
+      result.range = hit->distance;
+      // Lambertian: the echo weakens with the cosine of the angle between the beam and the surface.
+      result.intensity = hit->reflectivity * static_cast<float>(std::abs(hit->normal.dot(ray.direction)));
+      result.kind = hit->kind;
+    }
+  });
+  return returns;
+}
+
+bool Lidar::hitsVehicle(const Eigen::Vector3d& direction) const {
+  const Ray ray{Eigen::Vector3d::Zero(), direction};
+  for (const Shape& part : options_.vehicle_body) {
+    if (intersect(ray, part, 0.0, sensor_.max_range)) return true;
+  }
+  return false;
+}
+
+bool Lidar::detected(const Return& result, Rng& rng) const {
+  if (options_.detection_threshold <= 0.0) return true;
+  const double scale = kEchoReferenceRange / result.range;
+  const double strength = result.intensity * scale * scale;
+  return !rng.chance(std::exp(-strength / options_.detection_threshold));
+}
+
+SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const {
+  // One random stream in firing order: the same seed gives the same sweep whatever the thread count.
+  Rng rng(seed);
+  const int beams = beamCount();
+  SimulatedScan scan;
+  scan.cloud.stamp = stamp;
+  for (int step = 0; step < azimuthSteps(); ++step) {
+    for (int beam = 0; beam < beams; ++beam) {
+      const Return& result = returns[static_cast<size_t>(step) * beams + beam];
+      if (result.range <= 0.0 || !detected(result, rng) || rng.chance(options_.dropout_probability)) continue;
+      const double range = result.range + rng.gaussian(0.0, sensor_.range_noise_stddev);
+      if (range < sensor_.min_range || range > sensor_.max_range) continue;
+      scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
+      scan.cloud.intensity.push_back(result.intensity);
+      scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
+      scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
+      scan.surface.push_back(result.kind);
+    }
+  }
+  return scan;
+}
+
+}  // namespace elo::sim

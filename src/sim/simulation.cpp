@@ -1,0 +1,53 @@
+#include "elo/sim/simulation.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "elo/sim/rng.hpp"
+
+namespace elo::sim {
+namespace {
+
+constexpr uint64_t kNoiseStream = 4;   // apart from the world's streams (see world.cpp)
+constexpr double kReachMargin = 10.0;  // m of world beyond the sensor's range
+
+Route routeFor(const SimulationSpec& spec) {
+  const double frame_period = 1.0 / spec.config.sensor.rotation_rate_hz;
+  if (spec.driven_poses.empty()) {
+    // One sweep past the last frame's start, for the poses inside its sweep.
+    const double duration = (spec.frames + 1) * frame_period;
+    return proceduralRoute(spec.trajectory, cruiseSpeed(spec.world), duration);
+  }
+  if (spec.driven_poses.size() < static_cast<size_t>(spec.frames)) {
+    throw std::invalid_argument("the driven trajectory has " + std::to_string(spec.driven_poses.size()) +
+                                " poses, fewer than the " + std::to_string(spec.frames) + " frames asked for");
+  }
+  const size_t used = std::min(spec.driven_poses.size(), static_cast<size_t>(spec.frames) + 1);
+  return routeFromPoses({spec.driven_poses.begin(), spec.driven_poses.begin() + used}, frame_period);
+}
+
+}  // namespace
+
+Simulation::Simulation(const SimulationSpec& spec) : spec_(spec), lidar_(spec.config.sensor, spec.lidar) {
+  if (spec.frames <= 0) throw std::invalid_argument("a simulation needs at least one frame");
+  const Route route = routeFor(spec);
+  world_ = std::make_unique<World>(spec.world, route,
+                                   WorldOptions{spec.seed, spec.config.sensor.max_range + kReachMargin, spec.moving_cars});
+  trajectory_ = std::make_unique<SensorTrajectory>(route, world_->ground(), spec.config.ground.sensor_height);
+}
+
+double Simulation::stamp(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }
+
+Eigen::Isometry3d Simulation::sensorPose(int frame) const { return trajectory_->poseAt(stamp(frame)); }
+
+SimulatedScan Simulation::scan(int frame) const {
+  const double start = stamp(frame);
+  const Eigen::Isometry3d pose = trajectory_->poseAt(start);
+  // Moving cars stand where they are at the sweep's start; they move a metre or two during it.
+  const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
+  return lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
+                      mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
+}
+
+}  // namespace elo::sim

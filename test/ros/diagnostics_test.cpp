@@ -1,0 +1,58 @@
+// The diagnostics' summary and counters. No ROS master.
+#include <gtest/gtest.h>
+
+#include "diagnostics.hpp"
+
+namespace {
+
+std::string valueOf(const diagnostic_updater::DiagnosticStatusWrapper& status, const std::string& key) {
+  for (const auto& entry : status.values) {
+    if (entry.key == key) return entry.value;
+  }
+  return "<missing>";
+}
+
+elo::FrameResult processedScan(double total_ms) {
+  elo::FrameResult result;
+  result.processed = true;
+  result.times.total = total_ms;
+  result.registration.iterations = 3;
+  result.registration.last.nonground.candidates = 100;
+  result.registration.last.nonground.inliers = 80;
+  return result;
+}
+
+TEST(RosDiagnostics, QuietWindowIsOk) {
+  elo_ros::PipelineStatistics statistics;
+  statistics.cloudReceived();
+  statistics.scanProcessed(processedScan(60.0), 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  statistics.report(status);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
+  EXPECT_EQ(valueOf(status, "processing time mean (ms)"), "60");
+  EXPECT_EQ(valueOf(status, "latency max (ms)"), "65");
+  EXPECT_EQ(valueOf(status, "non-ground inlier ratio"), "0.8");
+  EXPECT_EQ(valueOf(status, "scans processed"), "1");
+}
+
+TEST(RosDiagnostics, DropsRejectionsAndSkipsWarnAndAreCounted) {
+  elo_ros::PipelineStatistics statistics;
+  statistics.cloudReceived();
+  statistics.cloudsDropped(2);
+  statistics.cloudRejected("truncated data");
+  statistics.scanSkipped("too few valid points");
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  statistics.report(status);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(status.message.find("2 dropped"), std::string::npos) << status.message;
+  EXPECT_NE(status.message.find("1 rejected"), std::string::npos) << status.message;
+  EXPECT_EQ(valueOf(status, "clouds rejected: truncated data"), "1");
+  EXPECT_EQ(valueOf(status, "scans skipped: too few valid points"), "1");
+
+  diagnostic_updater::DiagnosticStatusWrapper next;
+  statistics.report(next);
+  EXPECT_EQ(next.message, "no clouds received") << "a new window starts empty";
+  EXPECT_EQ(valueOf(next, "scans dropped"), "2") << "totals stay";
+}
+
+}  // namespace

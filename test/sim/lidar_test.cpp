@@ -1,0 +1,266 @@
+// The sensor on analytic scenes: exact ranges, beams, rings, times, range limits, noise and dropouts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "elo/sim/ground.hpp"
+#include "elo/sim/lidar.hpp"
+#include "elo/sim/scene.hpp"
+#include "sim_test_helpers.hpp"
+
+namespace elo::sim {
+namespace {
+
+using test::azimuthOf;
+using test::elevationsOf;
+using test::exactOptions;
+using test::exactSensor;
+using test::stepOf;
+
+constexpr double kSensorHeight = 1.73;
+
+Eigen::Isometry3d atOrigin(double) { return Eigen::Isometry3d::Identity(); }
+
+// A wall filling the half space x >= distance (thick, tall and wide enough for every forward beam).
+Scene wallScene(double distance) {
+  return Scene(nullptr, {{OrientedBox{Eigen::Vector3d(distance + 50.0, 0.0, 0.0), Eigen::Matrix3d::Identity(),
+                                      Eigen::Vector3d(50.0, 1000.0, 1000.0)},
+                          0.6f}});
+}
+
+double rangeOf(const PointCloud& cloud, size_t i) { return cloud.points[i].cast<double>().norm(); }
+
+TEST(Lidar, FlatGroundRangesAreExact) {
+  const SensorConfig sensor = exactSensor();
+  const Lidar lidar(sensor, exactOptions());
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, 0.0, 1);
+  const std::vector<double> elevations = elevationsOf(sensor);
+
+  std::vector<int> per_beam(lidar.beamCount(), 0);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const double elevation = elevations[scan.cloud.ring[i]];
+    ASSERT_LT(elevation, 0.0) << "a beam at or above the horizon hit a flat ground";
+    EXPECT_NEAR(rangeOf(scan.cloud, i), kSensorHeight / std::sin(-elevation), 2e-5);
+    EXPECT_NEAR(scan.cloud.points[i].z(), -kSensorHeight, 1e-5);
+    EXPECT_EQ(scan.surface[i], SurfaceKind::ground);
+    ++per_beam[scan.cloud.ring[i]];
+  }
+  // Every beam below the horizon whose ground range lies within the sensor's limits returns at every step.
+  for (int beam = 0; beam < lidar.beamCount(); ++beam) {
+    const double range = elevations[beam] < 0.0 ? kSensorHeight / std::sin(-elevations[beam]) : INFINITY;
+    const bool visible = range >= sensor.min_range && range <= sensor.max_range;
+    EXPECT_EQ(per_beam[beam], visible ? lidar.azimuthSteps() : 0) << "beam " << beam;
+  }
+}
+
+TEST(Lidar, WallRangesAreExact) {
+  const SensorConfig sensor = exactSensor();
+  const Lidar lidar(sensor, exactOptions());
+  const double distance = 12.0;
+  const SimulatedScan scan = lidar.sweep(wallScene(distance), atOrigin, 0.0, 1);
+  const std::vector<double> elevations = elevationsOf(sensor);
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+    const double elevation = elevations[scan.cloud.ring[i]];
+    EXPECT_NEAR(rangeOf(scan.cloud, i), distance / (std::cos(elevation) * std::cos(azimuth)), 2e-5);
+    EXPECT_NEAR(scan.cloud.points[i].x(), distance, 1e-5);
+  }
+}
+
+TEST(Lidar, RingTimeAndOrderSanity) {
+  const SensorConfig sensor = exactSensor();
+  const Lidar lidar(sensor, exactOptions());
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
+  const double stamp = 123.4;
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, stamp, 1);
+  EXPECT_EQ(scan.cloud.stamp, stamp);
+  ASSERT_EQ(scan.cloud.ring.size(), scan.cloud.size());
+  ASSERT_EQ(scan.cloud.time.size(), scan.cloud.size());
+  ASSERT_EQ(scan.cloud.intensity.size(), scan.cloud.size());
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    EXPECT_LT(scan.cloud.ring[i], lidar.beamCount());
+    EXPECT_GE(scan.cloud.time[i], 0.0f);
+    EXPECT_LT(scan.cloud.time[i], lidar.sweepDuration());
+    EXPECT_GE(scan.cloud.intensity[i], 0.0f);
+    EXPECT_LE(scan.cloud.intensity[i], 1.0f);
+    if (i > 0) {
+      EXPECT_GE(scan.cloud.time[i], scan.cloud.time[i - 1]) << "points not in firing order";
+    }
+    // Time grows clockwise from behind: the azimuth of the point matches its firing step.
+    const Eigen::Vector3f& p = scan.cloud.points[i];
+    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+    EXPECT_NEAR(std::remainder(std::atan2(p.y(), p.x()) - azimuth, 2.0 * M_PI), 0.0, 1e-5);
+  }
+}
+
+TEST(Lidar, NothingBeyondMaxRangeNorFromTheSky) {
+  SensorConfig sensor = exactSensor();
+  sensor.max_range = 30.0;
+  sensor.range_noise_stddev = 0.05;  // noise must not push points past the limit either
+  const Lidar lidar(sensor, exactOptions());
+  // The ground reaches out to infinity and the wall stands beyond the range.
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight),
+                    {{uprightBox(Eigen::Vector3d(60.0, 0.0, 0.0), Eigen::Vector3d(1.0, 200.0, 50.0), 0.0), 0.5f}});
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, 0.0, 5);
+  ASSERT_GT(scan.cloud.size(), 0u);
+  const std::vector<double> elevations = elevationsOf(sensor);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    EXPECT_LE(rangeOf(scan.cloud, i), sensor.max_range + 1e-4);
+    EXPECT_GE(rangeOf(scan.cloud, i), sensor.min_range - 1e-4);
+    EXPECT_LT(elevations[scan.cloud.ring[i]], 0.0);  // the beams above the horizon see only sky
+  }
+}
+
+TEST(Lidar, RangeNoiseHasTheConfiguredSpread) {
+  for (const double sigma : {0.02, 0.05}) {
+    SensorConfig sensor = exactSensor();
+    sensor.beam_elevations_deg = {6.0, 4.0, 2.0, 0.0, -2.0, -4.0, -6.0};
+    sensor.azimuth_steps = 3600;
+    sensor.range_noise_stddev = sigma;
+    const Lidar lidar(sensor, exactOptions());
+    const double distance = 10.0;
+    const SimulatedScan scan = lidar.sweep(wallScene(distance), atOrigin, 0.0, 11);
+    const std::vector<double> elevations = elevationsOf(sensor);
+    double sum = 0.0, sum_squares = 0.0;
+    for (size_t i = 0; i < scan.cloud.size(); ++i) {
+      const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+      const double exact = distance / (std::cos(elevations[scan.cloud.ring[i]]) * std::cos(azimuth));
+      const double error = rangeOf(scan.cloud, i) - exact;
+      sum += error;
+      sum_squares += error * error;
+    }
+    const double count = static_cast<double>(scan.cloud.size());
+    ASSERT_GT(count, 5000.0);
+    const double mean = sum / count;
+    const double stddev = std::sqrt(sum_squares / count - mean * mean);
+    EXPECT_NEAR(stddev, sigma, 0.1 * sigma);
+    EXPECT_NEAR(mean, 0.0, 0.05 * sigma);
+  }
+}
+
+TEST(Lidar, DropoutsRemoveTheirShareOfReturns) {
+  const SensorConfig sensor = exactSensor();
+  LidarOptions options = exactOptions();
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
+  const size_t all = Lidar(sensor, options).sweep(scene, atOrigin, 0.0, 1).cloud.size();
+  options.dropout_probability = 0.2;
+  const size_t kept = Lidar(sensor, options).sweep(scene, atOrigin, 0.0, 1).cloud.size();
+  EXPECT_NEAR(static_cast<double>(kept) / all, 0.8, 0.02);
+}
+
+TEST(Lidar, IntensityFallsWithIncidence) {
+  const SensorConfig sensor = exactSensor();
+  const Lidar lidar(sensor, exactOptions());
+  const SimulatedScan scan = lidar.sweep(wallScene(10.0), atOrigin, 0.0, 1);
+  // Straight ahead the beam meets the wall head on; at 60 deg azimuth, at 60 deg incidence.
+  float head_on = 0.0f, oblique = 1.0f;
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    if (scan.cloud.ring[i] != 2) continue;  // the horizontal beam
+    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+    if (std::abs(azimuth) < 1e-9) head_on = scan.cloud.intensity[i];
+    if (std::abs(azimuth - M_PI / 3.0) < 1e-9) oblique = scan.cloud.intensity[i];
+  }
+  EXPECT_NEAR(head_on, 0.6f, 1e-6);
+  EXPECT_NEAR(oblique, 0.3f, 1e-6);
+}
+
+TEST(Lidar, MotionDuringTheSweepMovesLaterFirings) {
+  SensorConfig sensor = exactSensor();
+  const Scene scene = wallScene(20.0);
+  const auto moving = [](double time) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation().x() = 10.0 * time;  // 10 m/s toward the wall
+    return pose;
+  };
+  LidarOptions options = exactOptions();
+  const SimulatedScan still = Lidar(sensor, options).sweep(scene, moving, 0.0, 1);
+  options.deskewed = false;
+  const Lidar skewed_lidar(sensor, options);
+  const SimulatedScan skewed = skewed_lidar.sweep(scene, moving, 0.0, 1);
+  ASSERT_GT(skewed.cloud.size(), 1000u);
+  for (size_t i = 0; i < skewed.cloud.size(); ++i) {
+    // Each firing sees the wall from where the sensor is at its time.
+    EXPECT_NEAR(skewed.cloud.points[i].x(), 20.0 - 10.0 * skewed.cloud.time[i], 1e-4);
+  }
+  for (const Eigen::Vector3f& point : still.cloud.points) EXPECT_NEAR(point.x(), 20.0, 1e-5);
+}
+
+TEST(Lidar, WeakEchoesThinOutWithRange) {
+  SensorConfig sensor = exactSensor();
+  sensor.beam_elevations_deg = {-1.0, -20.0};  // the road at 99 m and at 4.8 m
+  LidarOptions options = exactOptions();
+  options.detection_threshold = LidarOptions().detection_threshold;
+  const Lidar lidar(sensor, options);
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, 0.0, 3);
+  std::vector<double> share(2, 0.0);
+  for (const uint16_t ring : scan.cloud.ring) share[ring] += 1.0 / lidar.azimuthSteps();
+  EXPECT_GT(share[1], 0.99);
+  EXPECT_LT(share[0], 0.5);
+  EXPECT_GT(share[0], 0.05);
+}
+
+TEST(Lidar, TheCarHidesTheRoadJustInFrontAndBehind) {
+  SensorConfig sensor = exactSensor();
+  sensor.beam_elevations_deg = {-24.9};
+  sensor.azimuth_steps = 360;
+  LidarOptions options = exactOptions();
+  options.vehicle_body = LidarOptions::roofMountedCar();
+  const Lidar lidar(sensor, options);
+  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+  std::vector<bool> seen(lidar.azimuthSteps(), false);
+  for (const float time : scan.cloud.time) seen[stepOf(lidar, time)] = true;
+  const auto seenAt = [&](double degrees) {
+    return seen[static_cast<int>(std::lround((180.0 - degrees) / 360.0 * lidar.azimuthSteps())) % lidar.azimuthSteps()];
+  };
+  EXPECT_FALSE(seenAt(0.0));    // bonnet
+  EXPECT_FALSE(seenAt(180.0));  // boot
+  EXPECT_TRUE(seenAt(90.0));    // past the rounded roof, to the sides
+  EXPECT_TRUE(seenAt(-90.0));
+}
+
+TEST(Lidar, WindowsReturnNothing) {
+  // A facade 10 m ahead with one storey of windows: 1 m of wall, 1 m of glass, then wall again.
+  WindowGrid windows;
+  windows.storey_height = 3.0;
+  windows.sill_height = 1.0;
+  windows.window_height = 1.0;
+  windows.spacing = 4.0;
+  windows.window_width = 2.0;
+  Primitive facade{uprightBox(Eigen::Vector3d(10.5, 0.0, 0.0), Eigen::Vector3d(1.0, 8.0, 3.0), 0.0), 0.5f, windows};
+  // The face spans y in [-4, 4]: two bays of 4 m with glass in their middle 2 m, so glass where
+  // 1 < |y| < 3 and, 1 m above the box's bottom at z = -1.5, where -0.5 <= z < 0.5.
+  const Scene scene(nullptr, {facade});
+  const auto reflectivityToward = [&](double y, double z) {
+    const Eigen::Vector3d target(10.0, y, z);
+    const auto hit = scene.cast(Ray{Eigen::Vector3d::Zero(), target.normalized()}, 50.0);
+    return hit ? hit->reflectivity : -1.0f;
+  };
+  EXPECT_EQ(reflectivityToward(0.0, 0.0), 0.5f);   // wall between windows
+  EXPECT_EQ(reflectivityToward(2.0, 0.0), 0.0f);   // glass
+  EXPECT_EQ(reflectivityToward(2.0, 1.0), 0.5f);   // wall above the window
+  EXPECT_EQ(reflectivityToward(2.0, -1.0), 0.5f);  // wall below the sill
+  SensorConfig sensor = exactSensor();
+  sensor.beam_elevations_deg = {0.0};
+  const Lidar lidar(sensor, exactOptions());
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, 0.0, 1);
+  for (const Eigen::Vector3f& point : scan.cloud.points) {
+    EXPECT_TRUE(std::abs(point.y()) <= 1.0f + 1e-3f || std::abs(point.y()) >= 3.0f - 1e-3f) << point.y();
+  }
+  EXPECT_GT(scan.cloud.size(), 0u);
+}
+
+TEST(Lidar, RejectsUnusableSensors) {
+  SensorConfig sensor = exactSensor();
+  sensor.azimuth_steps = 0;
+  EXPECT_THROW(Lidar(sensor, exactOptions()), std::invalid_argument);
+  LidarOptions options = exactOptions();
+  options.dropout_probability = 1.5;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace elo::sim

@@ -1,0 +1,49 @@
+// Shared set-ups of the simulator tests: a small sensor for analytic scenes and range bookkeeping.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "elo/config.hpp"
+#include "elo/sensor_model.hpp"
+#include "elo/sim/lidar.hpp"
+
+namespace elo::sim::test {
+
+// A noise-free, dropout-free sensor with a few beams above and below the horizon, so that analytic
+// scenes can be checked ray by ray.
+inline SensorConfig exactSensor() {
+  SensorConfig sensor;
+  sensor.name = "exact";
+  sensor.beam_elevations_deg = {10.0, 2.0, 0.0, -1.0, -5.0, -12.5, -20.0, -24.9};
+  sensor.beam_count = 8;
+  sensor.azimuth_steps = 720;
+  sensor.min_range = 0.5;
+  sensor.max_range = 120.0;
+  sensor.range_noise_stddev = 0.0;
+  return sensor;
+}
+
+inline LidarOptions exactOptions() {
+  LidarOptions options;
+  options.dropout_probability = 0.0;
+  options.detection_threshold = 0.0;
+  options.vehicle_body.clear();
+  return options;
+}
+
+// The firing step of a point, recovered from its time offset.
+inline int stepOf(const Lidar& lidar, float time) {
+  return static_cast<int>(std::lround(time / lidar.sweepDuration() * lidar.azimuthSteps()));
+}
+
+// Elevation (rad) of each beam as the simulator fires it.
+inline std::vector<double> elevationsOf(const SensorConfig& sensor) {
+  std::vector<double> elevations;
+  for (const float elevation : beamElevations(sensor)) elevations.push_back(elevation);
+  return elevations;
+}
+
+inline double azimuthOf(const Lidar& lidar, int step) { return M_PI - 2.0 * M_PI * step / lidar.azimuthSteps(); }
+
+}  // namespace elo::sim::test

@@ -1,0 +1,135 @@
+// Routes, the vehicle standing on the simulated ground, and drives through KITTI poses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "../io/temp_directory.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/sim/simulation.hpp"
+#include "elo/sim/trajectory.hpp"
+
+namespace elo::sim {
+namespace {
+
+double speedAt(const Route& route, double time) {
+  const double step = 0.05;
+  const Pose2 a = route.at(time);
+  const Pose2 b = route.at(time + step);
+  return std::hypot(b.x - a.x, b.y - a.y) / step;
+}
+
+TEST(Route, ProceduralDrivesKeepRealisticSpeeds) {
+  for (const std::string& name : trajectoryNames()) {
+    const TrajectoryKind kind = *trajectoryKindFromName(name);
+    const Route route = proceduralRoute(kind, 12.0, 120.0);
+    EXPECT_LT(speedAt(route, 0.0), 0.5) << name << " does not start from rest";
+    // Once up to speed (1.5 m/s^2 takes 8 s to 12 m/s), never crawling except at stops.
+    double slowest = 1e9, fastest = 0.0, distance = 0.0;
+    for (double t = 0.0; t < 120.0; t += 0.05) {
+      const double speed = speedAt(route, t);
+      if (t > 10.0) slowest = std::min(slowest, speed);
+      fastest = std::max(fastest, speed);
+      distance += speed * 0.05;
+    }
+    EXPECT_LE(fastest, 12.0 + 1e-6) << name;
+    EXPECT_GT(distance / 120.0, kind == TrajectoryKind::stop_and_go ? 6.0 : 7.0) << name;
+    if (kind == TrajectoryKind::stop_and_go) {
+      EXPECT_LT(slowest, 1e-9) << name << " never stops";
+    } else {
+      EXPECT_GT(slowest, 3.0) << name;
+    }
+    EXPECT_EQ(trajectoryName(kind), name);
+  }
+  EXPECT_FALSE(trajectoryKindFromName("loop"));
+}
+
+TEST(Route, TurnsOfEachDesign) {
+  // A U-turn reverses the heading; a roundabout turns left by 90 deg net.
+  const Route uturn = proceduralRoute(TrajectoryKind::uturn, 10.0, 60.0);
+  const Route roundabout = proceduralRoute(TrajectoryKind::roundabout, 10.0, 60.0);
+  const auto headingAfter = [](const Route& route, double metres) {
+    double travelled = 0.0, time = 0.0;
+    while (travelled < metres) {
+      travelled += speedAt(route, time) * 0.05;
+      time += 0.05;
+    }
+    return route.at(time).heading;
+  };
+  EXPECT_NEAR(headingAfter(uturn, 215.0), M_PI, 0.02);
+  EXPECT_NEAR(headingAfter(roundabout, 175.0), M_PI / 2.0, 0.02);
+}
+
+TEST(SensorTrajectory, SensorStandsAtItsHeightOnSlopesAndTiltsWithThem) {
+  SimulationSpec spec;
+  spec.world = WorldFamily::country;
+  spec.trajectory = TrajectoryKind::hill;
+  spec.frames = 400;
+  const Simulation simulation(spec);
+  double steepest_pitch = 0.0;
+  for (int frame = 0; frame < spec.frames; frame += 7) {
+    const Eigen::Isometry3d pose = simulation.sensorPose(frame);
+    const Eigen::Vector3d p = pose.translation();
+    EXPECT_NEAR(p.z() - simulation.world().ground().height(p.x(), p.y()), spec.config.ground.sensor_height, 1e-9);
+    steepest_pitch = std::max(steepest_pitch, std::abs(std::asin(pose.linear()(2, 0))));
+    // The body's up axis is the ground's normal to within the wheelbase's averaging.
+    const Eigen::Vector3d normal = simulation.world().ground().normal(p.x(), p.y());
+    EXPECT_GT(pose.linear().col(2).dot(normal), std::cos(3.0 * M_PI / 180.0));
+  }
+  EXPECT_GT(steepest_pitch, 3.0 * M_PI / 180.0) << "the hill drive never climbs";
+}
+
+std::vector<Eigen::Isometry3d> curvyLidarPoses(int count) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < count; ++i) {
+    const double t = 0.1 * i;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    const double heading = 0.3 * std::sin(0.2 * t);
+    pose.linear() = Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(9.0 * t, 20.0 * (1.0 - std::cos(0.2 * t)), 0.3 * t);
+    poses.push_back(pose);
+  }
+  // Relative to the first, as KITTI's are.
+  const Eigen::Isometry3d first_inverse = poses.front().inverse();
+  for (Eigen::Isometry3d& pose : poses) pose = first_inverse * pose;
+  return poses;
+}
+
+TEST(SensorTrajectory, DrivenPosesAreFollowedInXY) {
+  // Through a camera-frame KITTI file, as --poses reads one.
+  const elo::test::TempDirectory directory;
+  const std::vector<Eigen::Isometry3d> lidar = curvyLidarPoses(60);
+  writeKittiPoses(directory.file("poses.txt"), lidarToCamera(lidar, kittiVeloToCam00()));
+  SimulationSpec spec;
+  spec.driven_poses = cameraToLidar(readKittiPoses(directory.file("poses.txt")), kittiVeloToCam00());
+  spec.frames = 60;
+  const Simulation simulation(spec);
+  for (int frame = 0; frame < spec.frames; ++frame) {
+    const Eigen::Isometry3d simulated = simulation.sensorPose(frame);
+    EXPECT_NEAR(simulated.translation().x(), lidar[frame].translation().x(), 1e-6);
+    EXPECT_NEAR(simulated.translation().y(), lidar[frame].translation().y(), 1e-6);
+    const Eigen::Vector3d forward = simulated.linear().col(0);
+    const Eigen::Vector3d expected = lidar[frame].linear().col(0);
+    EXPECT_NEAR(std::atan2(forward.y(), forward.x()), std::atan2(expected.y(), expected.x()), 1e-6);
+  }
+  spec.frames = 61;
+  EXPECT_THROW(Simulation{spec}, std::invalid_argument);
+}
+
+TEST(SensorTrajectory, KittiSequence00IsFollowedInXY) {
+  const std::string path = std::string(ELO_SHARED_DATA) + "/kitti_gt/poses/00.txt";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no KITTI ground truth at " << path;
+  const std::vector<Eigen::Isometry3d> lidar = cameraToLidar(readKittiPoses(path), kittiVeloToCam00());
+  SimulationSpec spec;
+  spec.driven_poses = lidar;
+  spec.frames = 300;
+  const Simulation simulation(spec);
+  for (int frame = 0; frame < spec.frames; frame += 10) {
+    const Eigen::Vector3d simulated = simulation.sensorPose(frame).translation();
+    EXPECT_NEAR(simulated.x(), lidar[frame].translation().x(), 1e-6);
+    EXPECT_NEAR(simulated.y(), lidar[frame].translation().y(), 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace elo::sim

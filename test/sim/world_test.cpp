@@ -1,0 +1,191 @@
+// Whole simulations: every world gives a plausible HDL-64E scan, every sensor fires its beams, the
+// same seed gives byte-identical files, and the written ground truth is the simulated motion.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include "../io/temp_directory.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/sim/sensors.hpp"
+#include "elo/sim/sequence_writer.hpp"
+#include "elo/sim/simulation.hpp"
+
+namespace elo::sim {
+namespace {
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+size_t lineCount(const std::string& path) {
+  std::ifstream file(path);
+  size_t lines = 0;
+  for (std::string line; std::getline(file, line);) ++lines;
+  return lines;
+}
+
+double groundFraction(const SimulatedScan& scan) {
+  size_t ground = 0;
+  for (const SurfaceKind kind : scan.surface) ground += kind == SurfaceKind::ground ? 1 : 0;
+  return static_cast<double>(ground) / static_cast<double>(scan.surface.size());
+}
+
+class EveryWorld : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryWorld, GivesPlausibleHdl64Scans) {
+  SimulationSpec spec;
+  spec.world = *worldFamilyFromName(GetParam());
+  spec.trajectory = TrajectoryKind::curves;
+  spec.frames = 1000;
+  const Simulation simulation(spec);
+  // The ground's share over a drive: single scans vary with what stands beside the road (an open
+  // field, a row of cars). On an open motorway the road alone fills the HDL-64E's lower block of
+  // beams (-8.8 to -24.3 deg) and the next few above it, so most returns are ground there; elsewhere
+  // facades, parked cars and vegetation take a third or more.
+  const double most_ground = spec.world == WorldFamily::highway ? 0.92 : 0.7;
+  double ground_share = 0.0;
+  int scans = 0;
+  for (int frame = 0; frame < spec.frames; frame += 100, ++scans) {
+    const SimulatedScan scan = simulation.scan(frame);
+    EXPECT_GE(scan.cloud.size(), 60000u) << "frame " << frame;
+    EXPECT_LE(scan.cloud.size(), 130000u) << "frame " << frame;
+    ground_share += groundFraction(scan);
+  }
+  ground_share /= scans;
+  EXPECT_GE(ground_share, 0.3);
+  EXPECT_LE(ground_share, most_ground);
+}
+
+INSTANTIATE_TEST_SUITE_P(Worlds, EveryWorld, ::testing::ValuesIn(worldNames()),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+
+TEST(World, TheRoadStaysClearOfObjectsOnRoutesThatTurnBack) {
+  for (const WorldFamily family : {WorldFamily::urban, WorldFamily::parking, WorldFamily::country}) {
+    for (const TrajectoryKind kind : {TrajectoryKind::uturn, TrajectoryKind::roundabout}) {
+      const Route route = proceduralRoute(kind, cruiseSpeed(family), 90.0);
+      const World world(family, route, WorldOptions{});
+      // Upward rays from just above the road along the path, and a car's width to either side.
+      for (double time = 0.0; time < 90.0; time += 0.2) {
+        const Pose2 pose = route.at(time);
+        const Eigen::Vector2d left(-std::sin(pose.heading), std::cos(pose.heading));
+        for (const double offset : {-1.0, 0.0, 1.0}) {
+          const Eigen::Vector2d point = Eigen::Vector2d(pose.x, pose.y) + offset * left;
+          const Ray up{Eigen::Vector3d(point.x(), point.y(), world.ground().height(point.x(), point.y()) + 0.05),
+                       Eigen::Vector3d::UnitZ()};
+          ASSERT_FALSE(world.scene().cast(up, 3.0))
+              << worldName(family) << " " << trajectoryName(kind) << " blocked at t = " << time;
+        }
+      }
+    }
+  }
+}
+
+TEST(Sensors, EachFiresItsBeams) {
+  const std::map<std::string, int> beams = {{"hdl64", 64}, {"vlp16", 16}, {"vlp32", 32}, {"os1-64", 64}, {"os1-128", 128}};
+  for (const std::string& name : sensorNames()) {
+    SimulationSpec spec;
+    loadSensor(name, spec.config);
+    spec.frames = 2;
+    const Simulation simulation(spec);
+    EXPECT_EQ(simulation.lidar().beamCount(), beams.at(name)) << name;
+    const SimulatedScan scan = simulation.scan(1);
+    std::vector<bool> seen(simulation.lidar().beamCount(), false);
+    for (const uint16_t ring : scan.cloud.ring) seen[ring] = true;
+    // In a street canyon every beam, up or down, meets the road or a facade somewhere.
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), true), beams.at(name)) << name;
+    for (size_t i = 0; i < scan.cloud.size(); ++i) {
+      ASSERT_LE(scan.cloud.points[i].norm(), spec.config.sensor.max_range + 1e-3) << name;
+    }
+  }
+  Config config;
+  EXPECT_THROW(loadSensor("hdl32", config), std::invalid_argument);
+}
+
+SimulationSpec smallSpec(uint64_t seed) {
+  SimulationSpec spec;
+  loadSensor("vlp16", spec.config);
+  spec.world = WorldFamily::urban;
+  spec.trajectory = TrajectoryKind::straight;
+  spec.frames = 12;
+  spec.seed = seed;
+  spec.moving_cars = 6;
+  return spec;
+}
+
+TEST(Sequence, SameSeedSameBytesOtherSeedOtherScans) {
+  const elo::test::TempDirectory directory;
+  const auto write = [&](uint64_t seed, const std::string& name) {
+    const Simulation simulation(smallSpec(seed));
+    writeSequence(simulation, directory.file(name));
+  };
+  write(5, "a");
+  write(5, "b");
+  write(6, "c");
+  for (const std::string scan : {"000000.bin", "000011.bin"}) {
+    const std::string a = fileBytes(directory.file("a/velodyne/" + scan));
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, fileBytes(directory.file("b/velodyne/" + scan))) << scan;
+    EXPECT_NE(a, fileBytes(directory.file("c/velodyne/" + scan))) << scan;
+  }
+  EXPECT_EQ(fileBytes(directory.file("a/poses.txt")), fileBytes(directory.file("b/poses.txt")));
+}
+
+TEST(Sequence, GroundTruthIsTheSimulatedMotion) {
+  const elo::test::TempDirectory directory;
+  SimulationSpec spec = smallSpec(1);
+  spec.frames = 30;
+  const Simulation simulation(spec);
+  const SequenceSummary summary = writeSequence(simulation, directory.file("seq"));
+  EXPECT_EQ(summary.frames, 30);
+
+  const std::vector<Eigen::Isometry3d> poses = readKittiPoses(directory.file("seq/poses.txt"));
+  ASSERT_EQ(poses.size(), 30u);
+  EXPECT_TRUE(poses[0].isApprox(Eigen::Isometry3d::Identity(), 0.0));
+  const Route& route = simulation.trajectory().route();
+  for (size_t i = 1; i < poses.size(); ++i) {
+    const Eigen::Isometry3d step = poses[i - 1].inverse() * poses[i];
+    // A straight drive accelerating from rest: each frame moves as far as the route's speed profile
+    // says (over a gentle terrain, so the 3D step is the 2D one to 1 %), and forward.
+    const Pose2 from = route.at(simulation.stamp(static_cast<int>(i) - 1));
+    const Pose2 to = route.at(simulation.stamp(static_cast<int>(i)));
+    const double planned = std::hypot(to.x - from.x, to.y - from.y);
+    EXPECT_NEAR(step.translation().norm(), planned, 0.01 * planned + 1e-6) << "frame " << i;
+    EXPECT_GT(step.translation().x(), 0.99 * step.translation().norm());
+    // And it is the pose the scan was taken from, relative to the first.
+    const Eigen::Isometry3d simulated = simulation.sensorPose(0).inverse() * simulation.sensorPose(static_cast<int>(i));
+    EXPECT_TRUE(simulated.isApprox(poses[i], 1e-9));
+  }
+  // At 1.5 m/s^2 from rest, the step from 2.8 s to 2.9 s covers 0.1 s at the mean speed 4.275 m/s.
+  const double last_step = (poses[28].inverse() * poses[29]).translation().norm();
+  EXPECT_NEAR(last_step, 0.1 * 1.5 * 2.85, 0.01);
+
+  const std::vector<double> stamps = readTimes(directory.file("seq/times.txt"));
+  ASSERT_EQ(stamps.size(), 30u);
+  EXPECT_DOUBLE_EQ(stamps[0], 0.0);
+  EXPECT_NEAR(stamps[29], 2.9, 1e-9);
+  EXPECT_TRUE(readKittiCalibration(directory.file("seq/calib.txt")).isApprox(kittiVeloToCam00(), 1e-12));
+  const PointCloud first = readKittiBin(directory.file("seq/velodyne/000000.bin"));
+  EXPECT_EQ(first.size(), simulation.scan(0).cloud.size());
+  EXPECT_EQ(lineCount(directory.file("seq/poses.txt")), 30u);
+}
+
+TEST(Traffic, MovingCarsAppearAndMove) {
+  SimulationSpec spec;
+  spec.world = WorldFamily::highway;
+  spec.trajectory = TrajectoryKind::straight;
+  spec.frames = 200;
+  spec.moving_cars = 40;
+  const Simulation simulation(spec);
+  size_t moving_points = 0;
+  for (int frame = 0; frame < spec.frames; frame += 40) {
+    const SimulatedScan scan = simulation.scan(frame);
+    for (const SurfaceKind kind : scan.surface) moving_points += kind == SurfaceKind::moving_object ? 1 : 0;
+  }
+  EXPECT_GT(moving_points, 100u);
+}
+
+}  // namespace
+}  // namespace elo::sim

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Accuracy on simulated sequences with exact ground truth: every world with the HDL-64E, every other
+# sensor in the urban world (about 1 km each), and a drive through KITTI 00's ground-truth poses when
+# the shared data has them. Prints one table (KITTI metric t_rel and r_rel, ATE, odometry FPS).
+# Usage:
+#   tools/accuracy.sh BUILD_DIR [SHARED_DATA_DIR]
+# Works in BUILD_DIR/accuracy/ (scans are deleted after each run, trajectories kept); the table is
+# also written to BUILD_DIR/accuracy/table.txt. Takes about 40 minutes on 2 cores.
+set -euo pipefail
+build=${1:-build}
+data=${2:-../shared/data}
+bin="$build/devel/lib/elo_odometry"
+work="$build/accuracy"
+for tool in elo_sim elo_run elo_eval; do
+  [ -x "$bin/$tool" ] || { echo "accuracy: $bin/$tool is missing; build first (make build)" >&2; exit 1; }
+done
+rm -rf "$work"
+mkdir -p "$work"
+table="$work/table.txt"
+printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m FPS |
+  tee "$table"
+
+# evaluate LABEL SENSOR MODE: runs the odometry over the sequence simulated for LABEL and SENSOR and
+# adds a table row.
+evaluate() {
+  local label=$1 sensor=$2 mode=$3
+  local dir="$work/${label//\//-}-$sensor"
+  local fps
+  fps=$("$bin/elo_run" --input "$dir/sequence" --output "$dir/$mode.txt" --mode "$mode" --quiet |
+    awk '/^FPS:/ {print $2}')
+  "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$mode.txt" | tail -n 1 |
+    awk -v w="$label" -v s="$sensor" -v m="$mode" -v f="$fps" \
+      '{printf "%-18s %-8s %-5s %7d %9.1f %9.3f %15.4f %8.3f %6.1f\n", w, s, m, $2, $3, $4, $5, $8, f}' |
+    tee -a "$table"
+}
+
+# simulate_and_evaluate LABEL SENSOR MODES ELO_SIM_ARGS...: one sequence, one table row per mode.
+simulate_and_evaluate() {
+  local label=$1 sensor=$2 modes=$3
+  shift 3
+  local dir="$work/${label//\//-}-$sensor"
+  "$bin/elo_sim" --sensor "$sensor" --seed 7 --output "$dir/sequence" "$@" >&2
+  for mode in $modes; do
+    evaluate "$label" "$sensor" "$mode"
+  done
+  rm -rf "$dir/sequence/velodyne"
+}
+
+# Frames for about 1 km from rest at each world's cruise speed (urban 10, highway 25, country 18,
+# parking 5 m/s; 1.5 m/s^2 to get there).
+simulate_and_evaluate urban/curves hdl64 "f2m f2f" --world urban --trajectory curves --frames 1050
+simulate_and_evaluate highway/curves hdl64 "f2m f2f" --world highway --trajectory curves --frames 490
+simulate_and_evaluate country/hill hdl64 "f2m f2f" --world country --trajectory hill --frames 620
+simulate_and_evaluate parking/uturn hdl64 "f2m f2f" --world parking --trajectory uturn --frames 2020
+for sensor in vlp16 vlp32 os1-64 os1-128; do
+  simulate_and_evaluate urban/roundabout "$sensor" f2m --world urban --trajectory roundabout --frames 1050
+done
+kitti_poses="$data/kitti_gt/poses/00.txt"
+if [ -f "$kitti_poses" ]; then
+  # KITTI 00's 4541 poses (3.7 km) through an urban world.
+  simulate_and_evaluate urban/kitti00 hdl64 f2m --world urban --poses "$kitti_poses"
+else
+  echo "accuracy: no KITTI ground truth at $kitti_poses (shared data absent); KITTI 00 drive skipped" >&2
+fi
+echo "table: $table"

@@ -1,0 +1,176 @@
+// kitti_to_bag: writes a sequence on disk (KITTI layout, elo_sim output, or a directory of PCD scans) as
+// a ROS bag of sensor_msgs/PointCloud2 at the sequence's timestamps, with the ground truth as
+// nav_msgs/Odometry and TF when the sequence has poses. Thin: parse flags, load scans, write messages.
+#include <nav_msgs/Odometry.h>
+#include <rosbag/bag.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "cloud_conversion.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/io/sequence.hpp"
+
+namespace {
+
+constexpr char kUsage[] = R"(usage: kitti_to_bag --input DIR --output BAG [options]
+
+Writes the scans of DIR (KITTI layout: DIR/velodyne/*.bin with optional times.txt, poses.txt and
+calib.txt; elo_sim output; or a directory of .pcd / .bin scans) to BAG as sensor_msgs/PointCloud2
+(x y z intensity float32, ring uint16 and time float32 when the scans have them), each stamped and
+recorded at its scan time plus --start-time. With DIR/poses.txt the ground truth goes to
+/ground_truth (nav_msgs/Odometry) and /tf, as the sensor's pose in the frame of the first scan.
+
+options:
+  --topic NAME          cloud topic (default /points)
+  --frame NAME          the clouds' frame_id (default velodyne)
+  --frames N            write only the first N scans
+  --start-time S        seconds added to every scan time (default 1: ROS reads time 0 as 'no time')
+  --poses-frame camera|lidar
+                        the frame poses.txt is written in: camera for KITTI odometry (converted to
+                        the LiDAR frame with calib.txt), lidar for elo_sim. Required when DIR has
+                        both poses.txt and calib.txt, since both tools write both files.
+  --gt-frame NAME       parent frame of the ground truth (default odom: the frame the odometry starts
+                        in when it publishes the sensor frame directly)
+  --gt-child-frame NAME child frame of the ground truth (default <frame>_ground_truth)
+  --help
+)";
+
+struct Options {
+  std::string input;
+  std::string output;
+  std::string topic = "/points";
+  std::string frame = "velodyne";
+  size_t max_frames = 0;
+  double start_time = 1.0;
+  std::optional<std::string> poses_frame;
+  std::string gt_frame = "odom";
+  std::string gt_child_frame;  // empty: <frame>_ground_truth
+};
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <typename T>
+T parseNumber(const std::string& flag, const std::string& text) {
+  try {
+    size_t used = 0;
+    const T value = std::is_integral_v<T> ? static_cast<T>(std::stoul(text, &used)) : static_cast<T>(std::stod(text, &used));
+    if (used == text.size()) return value;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(flag + " expects a number, got '" + text + "'");
+}
+
+Options parseArguments(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(flag + " needs a value");
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else if (flag == "--input") {
+      options.input = value();
+    } else if (flag == "--output") {
+      options.output = value();
+    } else if (flag == "--topic") {
+      options.topic = value();
+    } else if (flag == "--frame") {
+      options.frame = value();
+    } else if (flag == "--frames") {
+      options.max_frames = parseNumber<size_t>(flag, value());
+    } else if (flag == "--start-time") {
+      options.start_time = parseNumber<double>(flag, value());
+    } else if (flag == "--poses-frame") {
+      options.poses_frame = value();
+      if (*options.poses_frame != "camera" && *options.poses_frame != "lidar") {
+        throw UsageError("--poses-frame must be camera or lidar, got '" + *options.poses_frame + "'");
+      }
+    } else if (flag == "--gt-frame") {
+      options.gt_frame = value();
+    } else if (flag == "--gt-child-frame") {
+      options.gt_child_frame = value();
+    } else {
+      throw UsageError("unknown option '" + flag + "'");
+    }
+  }
+  if (options.input.empty() || options.output.empty()) throw UsageError("--input and --output are required");
+  if (options.gt_child_frame.empty()) options.gt_child_frame = options.frame + "_ground_truth";
+  return options;
+}
+
+// The sensor's ground-truth poses in the frame of the first scan, or none when DIR has no poses.txt.
+std::vector<Eigen::Isometry3d> sensorGroundTruth(const elo::Sequence& sequence, const Options& options) {
+  if (!sequence.hasGroundTruth()) return {};
+  std::string frame = options.poses_frame.value_or(sequence.hasCalibration() ? "" : "lidar");
+  if (frame.empty()) {
+    throw UsageError("'" + sequence.directory() +
+                     "' has poses.txt and calib.txt: say --poses-frame camera (KITTI odometry) or lidar (elo_sim)");
+  }
+  if (frame == "lidar") return sequence.groundTruth();
+  if (!sequence.hasCalibration()) throw UsageError("--poses-frame camera needs calib.txt in '" + sequence.directory() + "'");
+  return elo::cameraToLidar(sequence.groundTruth(), sequence.calibration());
+}
+
+void writeGroundTruth(rosbag::Bag& bag, const ros::Time& stamp, const Eigen::Isometry3d& pose, const Options& options) {
+  nav_msgs::Odometry odometry;
+  odometry.header.stamp = stamp;
+  odometry.header.frame_id = options.gt_frame;
+  odometry.child_frame_id = options.gt_child_frame;
+  odometry.pose.pose = tf2::toMsg(pose);
+  bag.write("/ground_truth", stamp, odometry);
+
+  geometry_msgs::TransformStamped transform = tf2::eigenToTransform(pose);
+  transform.header = odometry.header;
+  transform.child_frame_id = options.gt_child_frame;
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(transform);
+  bag.write("/tf", stamp, tf);
+}
+
+int run(const Options& options) {
+  const elo::Sequence sequence(options.input);
+  const size_t scans = options.max_frames > 0 ? std::min(options.max_frames, sequence.size()) : sequence.size();
+  const std::vector<Eigen::Isometry3d> ground_truth = sensorGroundTruth(sequence, options);
+  rosbag::Bag bag(options.output, rosbag::bagmode::Write);
+  size_t points = 0;
+  for (size_t i = 0; i < scans; ++i) {
+    elo::PointCloud cloud = sequence.load(i);
+    cloud.stamp += options.start_time;
+    const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, options.frame);
+    bag.write(options.topic, message.header.stamp, message);
+    if (!ground_truth.empty()) writeGroundTruth(bag, message.header.stamp, ground_truth[i], options);
+    points += cloud.size();
+  }
+  bag.close();
+  std::printf("wrote %zu scans (%zu points) on %s%s to %s\n", scans, points, options.topic.c_str(),
+              ground_truth.empty() ? "" : ", with ground truth on /ground_truth and /tf", options.output.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArguments(argc, argv));
+  } catch (const UsageError& error) {
+    std::cerr << "kitti_to_bag: " << error.what() << "\n\n" << kUsage;
+    return 2;
+  } catch (const std::exception& error) {
+    std::cerr << "kitti_to_bag: " << error.what() << '\n';
+    return 1;
+  }
+}
