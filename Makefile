@@ -1,5 +1,6 @@
-# Entry points for a fresh Debian 12 machine. `make test` installs what is missing, builds and runs
-# every test; `make bench` prints the speed figures.
+# Entry points for a fresh Debian 12 machine. `make demo` installs what is missing, builds and runs the
+# odometry on a simulated drive; `make test` does the same and runs every test; `make bench` prints the
+# speed figures; `make accuracy` the accuracy table on simulated sequences.
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
 export PATH := /usr/bin:$(PATH)
@@ -16,7 +17,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools
 
-.PHONY: deps build test bench clean
+.PHONY: deps build test bench demo accuracy clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -36,6 +37,14 @@ test: build
 
 bench: build
 	tools/bench.sh $(BUILD) $(SHARED_DATA)
+
+# The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth.
+demo: build
+	tools/demo.sh $(BUILD) $(SHARED_DATA)
+
+# The accuracy table over simulated worlds, sensors and modes.
+accuracy: build
+	tools/accuracy.sh $(BUILD) $(SHARED_DATA)
 
 clean:
 	rm -rf $(BUILD)

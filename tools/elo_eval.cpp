@@ -12,6 +12,7 @@
 #include "elo/eval/plot.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
+#include "command_line.hpp"
 
 namespace fs = std::filesystem;
 
@@ -44,29 +45,22 @@ struct Options {
   bool tum = false;
 };
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using elo::tools::UsageError;
 
 Options parseArguments(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(argument + " needs a value");
-      return argv[++i];
-    };
-    if (argument == "--gt") {
-      options.ground_truth = value();
-    } else if (argument == "--est") {
-      options.estimate = value();
-    } else if (argument == "--plot") {
-      options.plot = value();
-    } else if (argument == "--tum") {
+  elo::tools::Arguments arguments(argc, argv);
+  while (arguments.next()) {
+    if (arguments.is("--gt")) {
+      options.ground_truth = arguments.value();
+    } else if (arguments.is("--est")) {
+      options.estimate = arguments.value();
+    } else if (arguments.is("--plot")) {
+      options.plot = arguments.value();
+    } else if (arguments.is("--tum")) {
       options.tum = true;
     } else {
-      throw UsageError("unknown argument '" + argument + "'");
+      arguments.rejectFlag();
     }
   }
   if (options.ground_truth.empty() || options.estimate.empty()) {
@@ -171,23 +165,22 @@ int run(const Options& options) {
   return 0;
 }
 
+// Reports an unreadable or mismatched input: the caller's mistake as much as a wrong flag, so exit 2.
+int badInput(const char* message) {
+  std::cerr << "elo_eval: " << message << '\n';
+  return kExitBadInput;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::cout << kUsage;
-      return 0;
+  return elo::tools::runTool("elo_eval", kUsage, argc, argv, [&] {
+    try {
+      return run(parseArguments(argc, argv));
+    } catch (const elo::IoError& error) {
+      return badInput(error.what());
+    } catch (const fs::filesystem_error& error) {
+      return badInput(error.what());
     }
-  }
-  try {
-    return run(parseArguments(argc, argv));
-  } catch (const UsageError& error) {
-    std::cerr << "elo_eval: " << error.what() << "\n\n" << kUsage;
-  } catch (const elo::IoError& error) {
-    std::cerr << "elo_eval: " << error.what() << "\n";
-  } catch (const fs::filesystem_error& error) {
-    std::cerr << "elo_eval: " << error.what() << "\n";
-  }
-  return kExitBadInput;
+  });
 }

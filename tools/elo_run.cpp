@@ -18,6 +18,7 @@
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
 #include "elo/odometry.hpp"
+#include "command_line.hpp"
 
 namespace {
 
@@ -54,58 +55,43 @@ struct Options {
   bool dump_config = false;
 };
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using elo::tools::UsageError;
 
 Options parseArguments(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (flag == "--input") {
-      options.input = value();
-    } else if (flag == "--output") {
-      options.output = value();
-    } else if (flag == "--config") {
-      options.config_file = value();
-    } else if (flag == "--mode") {
-      const std::string mode = value();
+  elo::tools::Arguments arguments(argc, argv);
+  while (arguments.next()) {
+    if (arguments.is("--input")) {
+      options.input = arguments.value();
+    } else if (arguments.is("--output")) {
+      options.output = arguments.value();
+    } else if (arguments.is("--config")) {
+      options.config_file = arguments.value();
+    } else if (arguments.is("--mode")) {
+      const std::string mode = arguments.value();
       if (mode != "f2m" && mode != "f2f") throw UsageError("--mode must be f2m or f2f, got '" + mode + "'");
       options.overrides.emplace_back("model.mode", mode == "f2m" ? "frame_to_model" : "frame_to_frame");
-    } else if (flag == "--threads") {
-      options.overrides.emplace_back("runtime.threads", value());
-    } else if (flag == "--set") {
-      const std::string assignment = value();
+    } else if (arguments.is("--threads")) {
+      options.overrides.emplace_back("runtime.threads", std::to_string(arguments.number<int>()));
+    } else if (arguments.is("--set")) {
+      const std::string assignment = arguments.value();
       const size_t equals = assignment.find('=');
       if (equals == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + assignment + "'");
       options.overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
-    } else if (flag == "--frames") {
-      const std::string text = value();
-      try {
-        options.max_frames = std::stoul(text);
-      } catch (const std::exception&) {
-        throw UsageError("--frames expects a count, got '" + text + "'");
-      }
-    } else if (flag == "--timing") {
-      options.timing_csv = value();
-    } else if (flag == "--tum") {
-      options.tum_output = value();
-    } else if (flag == "--camera-output") {
-      options.camera_output = value();
-    } else if (flag == "--quiet") {
+    } else if (arguments.is("--frames")) {
+      options.max_frames = arguments.number<size_t>();
+    } else if (arguments.is("--timing")) {
+      options.timing_csv = arguments.value();
+    } else if (arguments.is("--tum")) {
+      options.tum_output = arguments.value();
+    } else if (arguments.is("--camera-output")) {
+      options.camera_output = arguments.value();
+    } else if (arguments.is("--quiet")) {
       options.quiet = true;
-    } else if (flag == "--dump-config") {
+    } else if (arguments.is("--dump-config")) {
       options.dump_config = true;
     } else {
-      throw UsageError("unknown option '" + flag + "'");
+      arguments.rejectFlag();
     }
   }
   if (!options.dump_config && (options.input.empty() || options.output.empty())) {
@@ -251,13 +237,5 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArguments(argc, argv));
-  } catch (const UsageError& error) {
-    std::cerr << "elo_run: " << error.what() << "\n\n" << kUsage;
-    return 2;
-  } catch (const std::exception& error) {
-    std::cerr << "elo_run: " << error.what() << '\n';
-    return 1;
-  }
+  return elo::tools::runTool("elo_run", kUsage, argc, argv, [&] { return run(parseArguments(argc, argv)); });
 }

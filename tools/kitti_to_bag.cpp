@@ -17,6 +17,7 @@
 #include "cloud_conversion.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
+#include "command_line.hpp"
 
 namespace {
 
@@ -55,34 +56,15 @@ struct Options {
   std::string gt_child_frame;  // empty: <frame>_ground_truth
 };
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-template <typename T>
-T parseNumber(const std::string& flag, const std::string& text) {
-  try {
-    size_t used = 0;
-    const T value = std::is_integral_v<T> ? static_cast<T>(std::stoul(text, &used)) : static_cast<T>(std::stod(text, &used));
-    if (used == text.size()) return value;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + " expects a number, got '" + text + "'");
-}
+using elo::tools::UsageError;
 
 Options parseArguments(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (flag == "--input") {
+  elo::tools::Arguments arguments(argc, argv);
+  while (arguments.next()) {
+    const std::string& flag = arguments.flag();
+    const auto value = [&] { return arguments.value(); };
+    if (flag == "--input") {
       options.input = value();
     } else if (flag == "--output") {
       options.output = value();
@@ -91,9 +73,9 @@ Options parseArguments(int argc, char** argv) {
     } else if (flag == "--frame") {
       options.frame = value();
     } else if (flag == "--frames") {
-      options.max_frames = parseNumber<size_t>(flag, value());
+      options.max_frames = arguments.number<size_t>();
     } else if (flag == "--start-time") {
-      options.start_time = parseNumber<double>(flag, value());
+      options.start_time = arguments.number<double>();
     } else if (flag == "--poses-frame") {
       options.poses_frame = value();
       if (*options.poses_frame != "camera" && *options.poses_frame != "lidar") {
@@ -104,7 +86,7 @@ Options parseArguments(int argc, char** argv) {
     } else if (flag == "--gt-child-frame") {
       options.gt_child_frame = value();
     } else {
-      throw UsageError("unknown option '" + flag + "'");
+      arguments.rejectFlag();
     }
   }
   if (options.input.empty() || options.output.empty()) throw UsageError("--input and --output are required");
@@ -164,13 +146,5 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArguments(argc, argv));
-  } catch (const UsageError& error) {
-    std::cerr << "kitti_to_bag: " << error.what() << "\n\n" << kUsage;
-    return 2;
-  } catch (const std::exception& error) {
-    std::cerr << "kitti_to_bag: " << error.what() << '\n';
-    return 1;
-  }
+  return elo::tools::runTool("kitti_to_bag", kUsage, argc, argv, [&] { return run(parseArguments(argc, argv)); });
 }
