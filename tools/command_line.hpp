@@ -15,6 +15,25 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// `text` read whole as a number of type T, or a UsageError naming `flag`.
+template <typename T>
+T parseNumber(const std::string& flag, const std::string& text) {
+  try {
+    size_t used = 0;
+    T parsed;
+    if constexpr (std::is_integral_v<T>) {
+      const long long whole = std::stoll(text, &used);
+      if (whole < 0 && std::is_unsigned_v<T>) throw std::out_of_range(text);
+      parsed = static_cast<T>(whole);
+    } else {
+      parsed = static_cast<T>(std::stod(text, &used));
+    }
+    if (used == text.size()) return parsed;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(flag + " expects " + (std::is_integral_v<T> ? "an integer" : "a number") + ", got '" + text + "'");
+}
+
 class Arguments {
  public:
   Arguments(int argc, char** argv) : argc_(argc), argv_(argv) {}
@@ -37,21 +56,7 @@ class Arguments {
   // The value that follows the current flag, read whole as a number of type T.
   template <typename T>
   T number() {
-    const std::string text = value();
-    try {
-      size_t used = 0;
-      T parsed;
-      if constexpr (std::is_integral_v<T>) {
-        const long long whole = std::stoll(text, &used);
-        if (whole < 0 && std::is_unsigned_v<T>) throw std::out_of_range(text);
-        parsed = static_cast<T>(whole);
-      } else {
-        parsed = static_cast<T>(std::stod(text, &used));
-      }
-      if (used == text.size()) return parsed;
-    } catch (const std::exception&) {
-    }
-    throw UsageError(flag_ + " expects a number, got '" + text + "'");
+    return parseNumber<T>(flag_, value());
   }
 
   [[noreturn]] void rejectFlag() const { throw UsageError("unknown option '" + flag_ + "'"); }

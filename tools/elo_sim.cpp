@@ -16,6 +16,7 @@
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/sequence_writer.hpp"
 #include "elo/sim/simulation.hpp"
+#include "command_line.hpp"
 
 namespace {
 
@@ -57,10 +58,7 @@ std::string usage() {
          "  --help               this text\n";
 }
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using elo::tools::UsageError;
 
 struct Options {
   SimulationSpec spec;
@@ -68,27 +66,8 @@ struct Options {
   int threads = 0;
 };
 
-double parseNumber(const std::string& flag, const std::string& text) {
-  size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size()) throw UsageError(flag + " expects a number, got '" + text + "'");
-  return value;
-}
-
 long long parseInteger(const std::string& flag, const std::string& text, long long minimum) {
-  size_t used = 0;
-  long long value = 0;
-  try {
-    value = std::stoll(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size()) throw UsageError(flag + " expects an integer, got '" + text + "'");
+  const long long value = elo::tools::parseNumber<long long>(flag, text);
   if (value < minimum) throw UsageError(flag + " must be at least " + std::to_string(minimum));
   return value;
 }
@@ -161,11 +140,11 @@ Options parseOptions(int argc, char** argv) {
 
   if (const auto seed = take("--seed")) spec.seed = static_cast<uint64_t>(parseInteger("--seed", *seed, 0));
   if (const auto noise = take("--noise")) {
-    spec.config.sensor.range_noise_stddev = parseNumber("--noise", *noise);
+    spec.config.sensor.range_noise_stddev = elo::tools::parseNumber<double>("--noise", *noise);
     if (spec.config.sensor.range_noise_stddev < 0.0) throw UsageError("--noise must not be negative");
   }
   if (const auto dropout = take("--dropout")) {
-    spec.lidar.dropout_probability = parseNumber("--dropout", *dropout);
+    spec.lidar.dropout_probability = elo::tools::parseNumber<double>("--dropout", *dropout);
     if (spec.lidar.dropout_probability < 0.0 || spec.lidar.dropout_probability > 1.0) {
       throw UsageError("--dropout must lie in [0, 1]");
     }
