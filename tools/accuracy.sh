@@ -10,6 +10,7 @@ set -euo pipefail
 build=${1:-build}
 data=${2:-../shared/data}
 bin="$build/devel/lib/elo_odometry"
+configs="$(dirname "$0")/../config"
 work="$build/accuracy"
 for tool in elo_sim elo_run elo_eval; do
   [ -x "$bin/$tool" ] || { echo "accuracy: $bin/$tool is missing; build first (make build)" >&2; exit 1; }
@@ -20,13 +21,14 @@ table="$work/table.txt"
 printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m FPS |
   tee "$table"
 
-# evaluate LABEL SENSOR MODE: runs the odometry over the sequence simulated for LABEL and SENSOR and
-# adds a table row.
+# evaluate LABEL SENSOR MODE: runs the odometry, configured for SENSOR, over the sequence simulated for
+# LABEL and SENSOR and adds a table row.
 evaluate() {
   local label=$1 sensor=$2 mode=$3
   local dir="$work/${label//\//-}-$sensor"
   local fps
-  fps=$("$bin/elo_run" --input "$dir/sequence" --output "$dir/$mode.txt" --mode "$mode" --quiet |
+  fps=$("$bin/elo_run" --input "$dir/sequence" --output "$dir/$mode.txt" --config "$configs/$sensor.yaml" \
+    --mode "$mode" --quiet |
     awk '/^FPS:/ {print $2}')
   "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$mode.txt" | tail -n 1 |
     awk -v w="$label" -v s="$sensor" -v m="$mode" -v f="$fps" \
