@@ -35,7 +35,10 @@ class WindowSums {
   static constexpr int kLanes = 16;
 
   WindowSums(const Vec3f& centre, float distant_squared, const Vec3f& plane, float plane_distance)
-      : centre_(centre), distant_squared_(distant_squared), plane_(plane), plane_distance_(plane_distance) {}
+      : centre_(centre),
+        distant_squared_(distant_squared),
+        plane_(plane),
+        plane_distance_squared_(plane_distance * plane_distance) {}
 
   void addSegment(const NormalScratch& planes, size_t start, const float* __restrict window) {
     for (int base = 0; base < planes.span; base += kLanes) addLanes(planes, start + base, window + base);
@@ -68,10 +71,11 @@ class WindowSums {
       const float dy = y[i] - centre_.y();
       const float dz = z[i] - centre_.z();
       const float present = usable[i] * window[i];
-      const float far = present * static_cast<float>(dx * dx + dy * dy + dz * dz > distant_squared_);
-      const float off_plane = static_cast<float>(std::abs(dx * plane_.x() + dy * plane_.y() + dz * plane_.z()) >
-                                                 plane_distance_);
-      const float kept = (present - far) * (1.0f - off_plane);
+      // Selects, not branches or bool-to-float casts: both become vector blends.
+      const float far = dx * dx + dy * dy + dz * dz > distant_squared_ ? present : 0.0f;
+      const float plane_offset = dx * plane_.x() + dy * plane_.y() + dz * plane_.z();
+      const float on_plane = plane_offset * plane_offset > plane_distance_squared_ ? 0.0f : 1.0f;
+      const float kept = (present - far) * on_plane;
       lanes_[kNeighbours][i] += present;
       lanes_[kDistant][i] += far;
       lanes_[kCount][i] += kept;
@@ -100,7 +104,7 @@ class WindowSums {
   Vec3f centre_;
   float distant_squared_;
   Vec3f plane_;
-  float plane_distance_;
+  float plane_distance_squared_;
   alignas(64) float lanes_[kQuantities][kLanes] = {};
 };
 
