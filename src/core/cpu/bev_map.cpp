@@ -52,25 +52,37 @@ void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevI
   }
 }
 
+namespace {
+
+// Calls `visit(point)` for every point of `map` in the cells at Chebyshev distance `ring` from (row, col).
+template <typename Visit>
+void forEachPointOnRing(const BevImage& map, const BevProjection& projection, int row, int col, int ring,
+                        const Visit& visit) {
+  for (int r = std::max(0, row - ring); r <= std::min(projection.rows - 1, row + ring); ++r) {
+    const bool edge_row = r == row - ring || r == row + ring;
+    const int step = edge_row || ring == 0 ? 1 : 2 * ring;  // inner rows: only the ring's two ends
+    for (int c = col - ring; c <= col + ring; c += step) {
+      if (c < 0 || c >= projection.cols) continue;
+      const int32_t point = map.point_of_cell[r * projection.cols + c];
+      if (point >= 0) visit(point);
+    }
+  }
+}
+
+}  // namespace
+
 int32_t nearestGroundPoint(const BevImage& map, const BevProjection& projection, const Vec3f& point, int row, int col,
                            int radius) {
   for (int ring = 0; ring <= radius; ++ring) {
     int32_t best = -1;
     float best_distance = INFINITY;
-    for (int r = std::max(0, row - ring); r <= std::min(projection.rows - 1, row + ring); ++r) {
-      const bool edge_row = r == row - ring || r == row + ring;
-      const int step = edge_row || ring == 0 ? 1 : 2 * ring;  // inner rows: only the ring's two ends
-      for (int c = col - ring; c <= col + ring; c += step) {
-        if (c < 0 || c >= projection.cols) continue;
-        const int32_t candidate = map.point_of_cell[r * projection.cols + c];
-        if (candidate < 0) continue;
-        const float distance = (map.vertex[candidate] - point).squaredNorm();
-        if (distance < best_distance) {
-          best_distance = distance;
-          best = candidate;
-        }
+    forEachPointOnRing(map, projection, row, col, ring, [&](int32_t candidate) {
+      const float distance = (map.vertex[candidate] - point).squaredNorm();
+      if (distance < best_distance) {
+        best_distance = distance;
+        best = candidate;
       }
-    }
+    });
     if (best >= 0) return best;
   }
   return -1;
@@ -89,21 +101,22 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
                                 int32_t point) {
   if (states_[point].load(std::memory_order_acquire) == fitted) return normals_[point];
 
-  // The `normal_neighbours` model points of the patch nearest to the cell's vertex, kept sorted.
+  // The `normal_neighbours` model points of the patch nearest to the point, kept sorted. Rings of cells
+  // are searched outwards; once the farthest kept point is closer than any point of the next ring can be
+  // (ring - 1 cells, as the centre may lie at the edge of its own cell), the rest cannot change the result.
   const Vec3f& centre = model.vertex[point];
   const int row = model.cell[point] / projection.cols;
   const int col = model.cell[point] % projection.cols;
-  const int radius = config.normal_patch_radius;
   const int wanted = std::min(config.normal_neighbours, kMaxNormalNeighbours);
   std::array<float, kMaxNormalNeighbours> distances;
   std::array<Vec3f, kMaxNormalNeighbours> points;
   int used = 0;
-  for (int r = std::max(0, row - radius); r <= std::min(projection.rows - 1, row + radius); ++r) {
-    for (int c = std::max(0, col - radius); c <= std::min(projection.cols - 1, col + radius); ++c) {
-      const int32_t other = model.point_of_cell[r * projection.cols + c];
-      if (other < 0) continue;
+  for (int ring = 0; ring <= config.normal_patch_radius; ++ring) {
+    const float ring_distance = static_cast<float>(std::max(ring - 1, 0)) * projection.cell_size;
+    if (used == wanted && distances[used - 1] <= ring_distance * ring_distance) break;
+    forEachPointOnRing(model, projection, row, col, ring, [&](int32_t other) {
       const float distance = (model.vertex[other] - centre).squaredNorm();
-      if (used == wanted && distance >= distances[used - 1]) continue;
+      if (used == wanted && distance >= distances[used - 1]) return;
       int slot = used < wanted ? used++ : used - 1;
       for (; slot > 0 && distances[slot - 1] > distance; --slot) {
         distances[slot] = distances[slot - 1];
@@ -111,7 +124,7 @@ Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& proj
       }
       distances[slot] = distance;
       points[slot] = model.vertex[other];
-    }
+    });
   }
 
   const Vec3f normal = groundPlaneNormal(points.data(), used, centre);
