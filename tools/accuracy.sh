@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Accuracy on simulated sequences with exact ground truth: every world with the HDL-64E, every other
-# sensor in the urban world (about 1 km each), and a drive through KITTI 00's ground-truth poses when
-# the shared data has them. Prints one table (KITTI metric t_rel and r_rel, ATE, odometry FPS).
+# sensor in the urban world (about 1 km each), the paper's Table II/III ablation on one urban drive, and
+# a drive through KITTI 00's ground-truth poses when the shared data has them. Prints one table (KITTI metric t_rel and r_rel, ATE, odometry FPS).
 # Usage:
 #   tools/accuracy.sh BUILD_DIR [SHARED_DATA_DIR]
 # Works in BUILD_DIR/accuracy/ (scans are deleted after each run, trajectories kept); the table is
@@ -21,17 +21,20 @@ table="$work/table.txt"
 printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m FPS |
   tee "$table"
 
-# evaluate LABEL SENSOR MODE: runs the odometry, configured for SENSOR, over the sequence simulated for
-# LABEL and SENSOR and adds a table row.
+# evaluate LABEL SENSOR MODE [--set KEY=VALUE]: runs the odometry, configured for SENSOR, over the
+# sequence simulated for LABEL and SENSOR and adds a table row; a --set variant is named in the row.
 evaluate() {
   local label=$1 sensor=$2 mode=$3
+  shift 3
   local dir="$work/${label//\//-}-$sensor"
+  local variant=${2:-}
+  local name="$mode${variant:+-${variant//[.=]/_}}"
   local fps
-  fps=$("$bin/elo_run" --input "$dir/sequence" --output "$dir/$mode.txt" --config "$configs/$sensor.yaml" \
-    --mode "$mode" --quiet |
+  fps=$("$bin/elo_run" --input "$dir/sequence" --output "$dir/$name.txt" --config "$configs/$sensor.yaml" \
+    --mode "$mode" --quiet "$@" |
     awk '/^FPS:/ {print $2}')
-  "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$mode.txt" | tail -n 1 |
-    awk -v w="$label" -v s="$sensor" -v m="$mode" -v f="$fps" \
+  "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$name.txt" | tail -n 1 |
+    awk -v w="$label${variant:+ $variant}" -v s="$sensor" -v m="$mode" -v f="$fps" \
       '{printf "%-18s %-8s %-5s %7d %9.1f %9.3f %15.4f %8.3f %6.1f\n", w, s, m, $2, $3, $4, $5, $8, f}' |
     tee -a "$table"
 }
@@ -57,6 +60,15 @@ simulate_and_evaluate parking/uturn hdl64 "f2m f2f" --world parking --trajectory
 for sensor in vlp16 vlp32 os1-64 os1-128; do
   simulate_and_evaluate urban/roundabout "$sensor" f2m --world urban --trajectory roundabout --frames 1050
 done
+# The paper's Table II (each projection alone) and Table III (each normal estimator) on one urban drive.
+ablation="$work/urban-ablation-hdl64"
+"$bin/elo_sim" --sensor hdl64 --seed 7 --output "$ablation/sequence" --world urban --trajectory curves \
+  --frames 400 >&2
+for variant in registration.terms=fused registration.terms=spherical_all registration.terms=spherical_nonground \
+  registration.terms=bev_ground normals.method=eigen normals.method=cross_product; do
+  evaluate urban/ablation hdl64 f2m --set "$variant"
+done
+rm -rf "$ablation/sequence/velodyne"
 kitti_poses="$data/kitti_gt/poses/00.txt"
 if [ -f "$kitti_poses" ]; then
   # KITTI 00's 4541 poses (3.7 km) through an urban world.
