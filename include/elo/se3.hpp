@@ -14,8 +14,7 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v);
 Eigen::Isometry3d expSE3(const Vector6d& twist);
 Vector6d logSE3(const Eigen::Isometry3d& transform);
 
-// Rotation angle (rad) and translation length (m) of a transform: the sizes convergence tests need.
+// Rotation angle (rad) of a transform.
 double rotationAngle(const Eigen::Isometry3d& transform);
-double translationNorm(const Eigen::Isometry3d& transform);
 
 }  // namespace elo

@@ -50,7 +50,6 @@ struct ScanImage {
   std::vector<PixelLabel> label;
 
   void resize(int rows, int cols);
-  void clear();
 };
 
 // A bird's-eye-view map of ground points (Eq. 14): cell (row, col) of a `rows x cols` grid holds at

@@ -60,6 +60,4 @@ double rotationAngle(const Eigen::Isometry3d& transform) {
   return Eigen::AngleAxisd(transform.linear()).angle();
 }
 
-double translationNorm(const Eigen::Isometry3d& transform) { return transform.translation().norm(); }
-
 }  // namespace elo

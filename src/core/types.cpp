@@ -29,12 +29,6 @@ void ScanImage::resize(int rows, int cols) {
   label.assign(image.pixelCount(), PixelLabel::empty);
 }
 
-void ScanImage::clear() {
-  image.clear();
-  std::fill(point_index.begin(), point_index.end(), -1);
-  std::fill(label.begin(), label.end(), PixelLabel::empty);
-}
-
 void BevImage::resize(int grid_rows, int grid_cols) {
   rows = grid_rows;
   cols = grid_cols;
