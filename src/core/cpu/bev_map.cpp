@@ -22,8 +22,7 @@ Vec3f groundPlaneNormal(const Vec3f* points, int count, const Vec3f& origin) {
   if (count < 3) return Vec3f::Zero();
   PointMoments moments;
   for (int i = 0; i < count; ++i) moments.add(points[i] - origin);
-  const Vec3f mean = moments.sum / static_cast<float>(count);
-  const Eigen::Matrix3f covariance = moments.outer / static_cast<float>(count) - mean * mean.transpose();
+  const Eigen::Matrix3f covariance = moments.covariance();
   const float cxx = covariance(0, 0);
   const float cxy = covariance(0, 1);
   const float cyy = covariance(1, 1);

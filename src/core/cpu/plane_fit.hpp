@@ -25,16 +25,20 @@ struct PointMoments {
     outer.noalias() += p * p.transpose();
     ++count;
   }
+
+  // The covariance of the points about their mean.
+  Eigen::Matrix3f covariance() const {
+    const Eigen::Vector3f mean = sum / static_cast<float>(count);
+    return outer / static_cast<float>(count) - mean * mean.transpose();
+  }
 };
 
 // The plane of the points whose moments are given: eigen-decomposition of their covariance (Eq. 10-11).
 inline PlaneFit fitPlane(const PointMoments& moments) {
   PlaneFit fit;
   if (moments.count < 3) return fit;
-  const Eigen::Vector3f mean = moments.sum / static_cast<float>(moments.count);
-  const Eigen::Matrix3f covariance = moments.outer / static_cast<float>(moments.count) - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
-  solver.computeDirect(covariance);
+  solver.computeDirect(moments.covariance());
   const Eigen::Vector3f eigenvalues = solver.eigenvalues();  // ascending
   const float sum = eigenvalues.sum();
   if (!(sum > 0.0f)) return fit;
