@@ -32,9 +32,10 @@ options:
   --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config)
   --mode f2m|f2f       frame-to-model (default) or frame-to-frame
   --threads N          CPU threads (default: all)
+  --backend cpu|cuda   compute backend (runtime.backend; default cpu)
   --set KEY=VALUE      override one parameter, e.g. --set ground.sensor_height=1.8 (repeatable)
   --frames N           process only the first N scans
-  --timing CSV         per-frame stage times, iterations and inlier counts
+  --timing CSV         per-frame stage times, iterations, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
   --quiet              no progress bar
@@ -71,6 +72,8 @@ Options parseArguments(int argc, char** argv) {
       const std::string mode = arguments.value();
       if (mode != "f2m" && mode != "f2f") throw UsageError("--mode must be f2m or f2f, got '" + mode + "'");
       options.overrides.emplace_back("model.mode", mode == "f2m" ? "frame_to_model" : "frame_to_frame");
+    } else if (arguments.is("--backend")) {
+      options.overrides.emplace_back("runtime.backend", arguments.value());
     } else if (arguments.is("--threads")) {
       options.overrides.emplace_back("runtime.threads", std::to_string(arguments.number<int>()));
     } else if (arguments.is("--set")) {
@@ -138,18 +141,24 @@ StageSummary summarise(std::vector<double> values) {
 
 class Report {
  public:
-  void add(const elo::FrameResult& result) {
+  // `upload_ms`: the part of the projection that copied the scan to a device (0 on the CPU backend).
+  void add(const elo::FrameResult& result, double upload_ms) {
     if (!result.processed) return;
     projection_.push_back(result.times.projection);
+    upload_.push_back(upload_ms);
     features_.push_back(result.times.feature_extraction);
     registration_.push_back(result.times.registration);
     model_update_.push_back(result.times.model_update);
     total_.push_back(result.times.total);
   }
 
-  void print(const elo::Odometry& odometry, size_t scans, double wall_seconds) const {
+  void print(elo::Odometry& odometry, size_t scans, double wall_seconds) const {
     std::printf("\nframes: %zu scans, %zu processed", scans, odometry.processedCount());
     for (const auto& [reason, count] : odometry.skippedCounts()) std::printf(", %zu skipped (%s)", count, reason.c_str());
+    if (odometry.degenerateCount() > 0) {
+      std::printf(", %zu degenerate (the motion prior kept along what the scan did not constrain)",
+                  odometry.degenerateCount());
+    }
     std::printf("\n%-22s %10s %10s\n", "stage (ms)", "mean", "median");
     const std::pair<const char*, const std::vector<double>*> rows[] = {
         {"spherical projection", &projection_}, {"feature extraction", &features_},
@@ -160,23 +169,30 @@ class Report {
       std::printf("%-22s %10.2f %10.2f\n", name, s.mean, s.median);
     }
     const double mean_total = summarise(total_).mean;
+    const StageSummary upload = summarise(upload_);
+    if (upload.mean > 0.0) {
+      std::printf("%-22s %10.2f %10.2f   (part of the projection)\n", "scan upload to GPU", upload.mean, upload.median);
+      std::printf("FPS without the upload: %.1f\n", 1000.0 / (mean_total - upload.mean));
+    }
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     const int threads = odometry.config().runtime.threads;
-    std::printf("FPS: %.1f (pipeline), %.1f (wall, with reading scans); threads: %s; peak memory: %.0f MiB\n",
+    std::printf("FPS: %.1f (pipeline), %.1f (wall, with reading scans); backend: %s; threads: %s; peak memory: %.0f MiB\n",
                 mean_total > 0.0 ? 1000.0 / mean_total : 0.0, wall_seconds > 0.0 ? total_.size() / wall_seconds : 0.0,
-                threads > 0 ? std::to_string(threads).c_str() : "all", usage.ru_maxrss / 1024.0);
+                odometry.backend().name(), threads > 0 ? std::to_string(threads).c_str() : "all",
+                usage.ru_maxrss / 1024.0);
   }
 
  private:
-  std::vector<double> projection_, features_, registration_, model_update_, total_;
+  std::vector<double> projection_, upload_, features_, registration_, model_update_, total_;
 };
 
 void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {
   csv << index << ',' << stamp << ',' << (r.processed ? 1 : 0) << ',' << r.times.projection << ','
       << r.times.feature_extraction << ',' << r.times.registration << ',' << r.times.model_update << ','
       << r.times.total << ',' << r.registration.iterations << ',' << r.registration.last.nonground.inliers << ','
-      << r.registration.last.ground.inliers << ',' << r.registration.weight << '\n';
+      << r.registration.last.ground.inliers << ',' << r.registration.weight << ','
+      << r.registration.degeneracy.eigenvalues[0] << ',' << r.registration.degeneracy.describe() << '\n';
 }
 
 void showProgress(size_t done, size_t total) {
@@ -196,12 +212,13 @@ int run(const Options& options) {
   const elo::Sequence sequence(options.input);
   const size_t scans = options.max_frames > 0 ? std::min(options.max_frames, sequence.size()) : sequence.size();
   elo::Odometry odometry(config);
+  if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
   std::ofstream timing;
   if (!options.timing_csv.empty()) {
     timing.open(options.timing_csv);
     if (!timing) throw elo::IoError("cannot write " + options.timing_csv);
     timing << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
-              "iterations,nonground_inliers,ground_inliers,weight\n";
+              "iterations,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
   }
   const bool progress = !options.quiet && isatty(STDERR_FILENO);
   std::vector<Eigen::Isometry3d> poses;
@@ -216,9 +233,12 @@ int run(const Options& options) {
     const elo::FrameResult result = odometry.process(cloud);
     if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", i, result.skip_reason.c_str());
     if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", i);
+    if (result.gap_restart) {
+      std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", i);
+    }
     poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned with scans
     stamps.push_back(cloud.stamp);
-    report.add(result);
+    report.add(result, odometry.backend().lastUploadMilliseconds());
     if (timing) writeTimingRow(timing, i, cloud.stamp, result);
     if (progress) showProgress(i + 1, scans);
   }

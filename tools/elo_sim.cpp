@@ -17,6 +17,7 @@
 #include "elo/sim/sequence_writer.hpp"
 #include "elo/sim/simulation.hpp"
 #include "command_line.hpp"
+#include "sequence_bag.hpp"
 
 namespace {
 
@@ -33,19 +34,23 @@ std::string joined(const std::vector<std::string>& names) {
 std::string usage() {
   return "Usage: elo_sim --world " + joined(elo::sim::worldNames()) + "\n"
          "               (--trajectory " + joined(elo::sim::trajectoryNames()) + " | --poses FILE)\n"
-         "               --frames N --output DIR [options]\n"
+         "               --frames N --output DIR [--bag FILE] [options]\n"
          "\n"
          "Simulates a spinning LiDAR in a seeded procedural world and writes a KITTI-layout sequence:\n"
          "DIR/velodyne/%06d.bin, DIR/poses.txt (ground truth in the sensor frame, scan 0 = identity),\n"
          "DIR/times.txt and DIR/calib.txt (KITTI 00's Tr).\n"
          "\n"
-         "  --world NAME         kind of world: urban street canyon, highway, country road, parking lot\n"
+         "  --world NAME         kind of world: urban street canyon, highway, country road, parking lot,\n"
+         "                       tunnel (2 km of featureless tube, 100 m after the start)\n"
          "  --trajectory NAME    procedural drive at the world's speed (urban 10 m/s, highway 25 m/s,\n"
-         "                       country 18 m/s, parking 5 m/s)\n"
+         "                       country 18 m/s, parking 5 m/s, tunnel 16 m/s)\n"
          "  --poses FILE         drive through KITTI camera-frame ground-truth poses (converted to the\n"
          "                       LiDAR frame with KITTI 00's Tr; one pose per frame at 10 Hz)\n"
          "  --frames N           scans to simulate (with --poses: default all the poses)\n"
          "  --output DIR         where the sequence is written\n"
+         "  --bag FILE           also write the sequence as a ROS bag: sensor_msgs/PointCloud2 on /points\n"
+         "                       (x y z intensity ring time, frame velodyne), ground truth on\n"
+         "                       /ground_truth and /tf (as kitti_to_bag --poses-frame lidar)\n"
          "  --sensor NAME        " + joined(elo::sim::sensorNames()) + " (default hdl64)\n"
          "  --seed S             world, noise and dropout seed (default 1): same seed, same scans\n"
          "  --config FILE        YAML parameters applied over the sensor's (e.g. sensor.max_range)\n"
@@ -63,6 +68,7 @@ using elo::tools::UsageError;
 struct Options {
   SimulationSpec spec;
   std::string output;
+  std::optional<std::string> bag;
   int threads = 0;
 };
 
@@ -74,7 +80,7 @@ long long parseInteger(const std::string& flag, const std::string& text, long lo
 
 std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {"--world",  "--trajectory", "--poses",    "--frames",
-                                                 "--output", "--sensor",     "--seed",     "--config",
+                                                 "--output", "--bag",      "--sensor",     "--seed",     "--config",
                                                  "--noise",  "--dropout",    "--deskewed", "--moving-cars",
                                                  "--threads"};
   std::map<std::string, std::string> flags;
@@ -106,6 +112,7 @@ Options parseOptions(int argc, char** argv) {
   const auto output = take("--output");
   if (!output) throw UsageError("--output is required");
   options.output = *output;
+  options.bag = take("--bag");
 
   const auto trajectory = take("--trajectory");
   const auto poses = take("--poses");
@@ -162,15 +169,24 @@ int run(const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   elo::sim::SequenceSummary summary;
+  // --bag: the scans go to the bag as they are simulated, with the ring and per-point time that the
+  // KITTI .bin files cannot hold.
+  std::optional<elo_ros::SequenceBagWriter> bag;
+  if (options.bag) bag.emplace(*options.bag, elo_ros::SequenceBagOptions());
+  const elo::sim::ScanSink to_bag = [&bag](const elo::sim::SimulatedScan& scan, const Eigen::Isometry3d& pose) {
+    bag->write(scan.cloud, pose);
+  };
   arena.execute([&] {
     const elo::sim::Simulation simulation(options.spec);
-    summary = elo::sim::writeSequence(simulation, options.output);
+    summary = elo::sim::writeSequence(simulation, options.output, bag ? to_bag : elo::sim::ScanSink());
   });
+  if (bag) bag->close();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("wrote %d scans (%.0f points a scan) of %s to %s in %.1f s (%.1f scans/s, %d threads)\n",
               summary.frames, static_cast<double>(summary.points) / summary.frames,
               options.spec.config.sensor.name.c_str(), options.output.c_str(), seconds, summary.frames / seconds,
               arena.max_concurrency());
+  if (bag) std::printf("wrote the scans with ground truth to the bag %s\n", options.bag->c_str());
   return 0;
 }
 

@@ -1,23 +1,16 @@
 // kitti_to_bag: writes a sequence on disk (KITTI layout, elo_sim output, or a directory of PCD scans) as
 // a ROS bag of sensor_msgs/PointCloud2 at the sequence's timestamps, with the ground truth as
 // nav_msgs/Odometry and TF when the sequence has poses. Thin: parse flags, load scans, write messages.
-#include <nav_msgs/Odometry.h>
-#include <rosbag/bag.h>
-#include <tf2_eigen/tf2_eigen.h>
-#include <tf2_msgs/TFMessage.h>
-
 #include <algorithm>
 #include <cstdio>
-#include <iostream>
 #include <optional>
 #include <string>
-#include <type_traits>
 #include <vector>
 
-#include "cloud_conversion.hpp"
+#include "command_line.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
-#include "command_line.hpp"
+#include "sequence_bag.hpp"
 
 namespace {
 
@@ -47,13 +40,9 @@ options:
 struct Options {
   std::string input;
   std::string output;
-  std::string topic = "/points";
-  std::string frame = "velodyne";
-  size_t max_frames = 0;
-  double start_time = 1.0;
+  size_t max_frames = 0;  // 0: every scan
   std::optional<std::string> poses_frame;
-  std::string gt_frame = "odom";
-  std::string gt_child_frame;  // empty: <frame>_ground_truth
+  elo_ros::SequenceBagOptions bag;
 };
 
 using elo::tools::UsageError;
@@ -69,28 +58,27 @@ Options parseArguments(int argc, char** argv) {
     } else if (flag == "--output") {
       options.output = value();
     } else if (flag == "--topic") {
-      options.topic = value();
+      options.bag.topic = value();
     } else if (flag == "--frame") {
-      options.frame = value();
+      options.bag.frame = value();
     } else if (flag == "--frames") {
       options.max_frames = arguments.number<size_t>();
     } else if (flag == "--start-time") {
-      options.start_time = arguments.number<double>();
+      options.bag.start_time = arguments.number<double>();
     } else if (flag == "--poses-frame") {
       options.poses_frame = value();
       if (*options.poses_frame != "camera" && *options.poses_frame != "lidar") {
         throw UsageError("--poses-frame must be camera or lidar, got '" + *options.poses_frame + "'");
       }
     } else if (flag == "--gt-frame") {
-      options.gt_frame = value();
+      options.bag.gt_frame = value();
     } else if (flag == "--gt-child-frame") {
-      options.gt_child_frame = value();
+      options.bag.gt_child_frame = value();
     } else {
       arguments.rejectFlag();
     }
   }
   if (options.input.empty() || options.output.empty()) throw UsageError("--input and --output are required");
-  if (options.gt_child_frame.empty()) options.gt_child_frame = options.frame + "_ground_truth";
   return options;
 }
 
@@ -107,38 +95,20 @@ std::vector<Eigen::Isometry3d> sensorGroundTruth(const elo::Sequence& sequence, 
   return elo::cameraToLidar(sequence.groundTruth(), sequence.calibration());
 }
 
-void writeGroundTruth(rosbag::Bag& bag, const ros::Time& stamp, const Eigen::Isometry3d& pose, const Options& options) {
-  nav_msgs::Odometry odometry;
-  odometry.header.stamp = stamp;
-  odometry.header.frame_id = options.gt_frame;
-  odometry.child_frame_id = options.gt_child_frame;
-  odometry.pose.pose = tf2::toMsg(pose);
-  bag.write("/ground_truth", stamp, odometry);
-
-  geometry_msgs::TransformStamped transform = tf2::eigenToTransform(pose);
-  transform.header = odometry.header;
-  transform.child_frame_id = options.gt_child_frame;
-  tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(transform);
-  bag.write("/tf", stamp, tf);
-}
-
 int run(const Options& options) {
   const elo::Sequence sequence(options.input);
   const size_t scans = options.max_frames > 0 ? std::min(options.max_frames, sequence.size()) : sequence.size();
   const std::vector<Eigen::Isometry3d> ground_truth = sensorGroundTruth(sequence, options);
-  rosbag::Bag bag(options.output, rosbag::bagmode::Write);
-  size_t points = 0;
+  elo_ros::SequenceBagWriter bag(options.output, options.bag);
   for (size_t i = 0; i < scans; ++i) {
-    elo::PointCloud cloud = sequence.load(i);
-    cloud.stamp += options.start_time;
-    const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, options.frame);
-    bag.write(options.topic, message.header.stamp, message);
-    if (!ground_truth.empty()) writeGroundTruth(bag, message.header.stamp, ground_truth[i], options);
-    points += cloud.size();
+    if (ground_truth.empty()) {
+      bag.write(sequence.load(i));
+    } else {
+      bag.write(sequence.load(i), ground_truth[i]);
+    }
   }
   bag.close();
-  std::printf("wrote %zu scans (%zu points) on %s%s to %s\n", scans, points, options.topic.c_str(),
+  std::printf("wrote %zu scans (%zu points) on %s%s to %s\n", bag.scans(), bag.points(), options.bag.topic.c_str(),
               ground_truth.empty() ? "" : ", with ground truth on /ground_truth and /tf", options.output.c_str());
   return 0;
 }

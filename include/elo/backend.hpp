@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <string>
 
 #include "elo/config.hpp"
 #include "elo/se3.hpp"
@@ -30,6 +31,8 @@ struct NormalEquations {
   TermSums ground;     // E_G: scan BEV against the model BEV
 };
 
+// A device backend queues the work of a stage call and returns; a call whose result the host needs (the
+// occupied count, the sums, the host views) waits for it. The CPU backend finishes every call at once.
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -58,10 +61,20 @@ class Backend {
   virtual const ScanImage& scan() = 0;
   virtual const BevImage& scanGround() = 0;
   virtual const Model& model() = 0;
+
+  // Waits until every stage called so far has finished, so that its time can be taken.
+  virtual void synchronize() {}
+  // Of the last projectScan(), the time (ms) spent moving the cloud to the device; 0 on the host.
+  virtual double lastUploadMilliseconds() const { return 0.0; }
 };
 
-// Makes the backend `config.runtime.backend` names. Throws std::runtime_error when it cannot run here
-// (a CUDA backend without a usable GPU, or a build without CUDA).
-std::unique_ptr<Backend> makeBackend(const Config& config);
+// Makes the backend `config.runtime.backend` names. When that is the CUDA backend and it cannot run here
+// (no usable GPU, or a build without CUDA), throws std::runtime_error saying why, or with
+// runtime.backend_fallback returns the CPU backend and puts the reason into `*warning` (when given) for
+// the caller to show.
+std::unique_ptr<Backend> makeBackend(const Config& config, std::string* warning = nullptr);
+
+// Why the CUDA backend cannot run here, or empty when it can.
+std::string cudaUnavailableReason();
 
 }  // namespace elo

@@ -27,6 +27,9 @@ struct FrameResult {
   bool processed = false;
   std::string skip_reason;  // why the scan was not used, when !processed
   bool reset = false;       // the odometry restarted at this scan (time went backwards)
+  // The gap since the previous scan exceeded model.time_window: the model and the motion prior restarted
+  // at the last pose, which this scan keeps (the motion during the gap is unknown).
+  bool gap_restart = false;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // sensor in the odometry frame
   Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();  // T^{t-1}_t
   RegistrationResult registration;
@@ -40,6 +43,8 @@ class Odometry {
 
   // Processes one sweep. A scan that cannot be used (empty, too few valid points, a stamp that is not
   // finite or repeats the last one) is skipped, counted under its reason and leaves the state as it was.
+  // A stamp before the last one resets (see reset()); one more than model.time_window after it restarts
+  // the model at the current pose (FrameResult::gap_restart).
   FrameResult process(const PointCloud& cloud);
 
   // Forgets the model, the motion and the pose: the next scan starts a new trajectory at identity.
@@ -48,23 +53,39 @@ class Odometry {
   const Eigen::Isometry3d& pose() const { return pose_; }
   const Config& config() const { return config_; }
   Backend& backend() { return *backend_; }
+  // Why the odometry runs on another backend than runtime.backend asked for (runtime.backend_fallback);
+  // empty when it runs on that one.
+  const std::string& backendWarning() const { return backend_warning_; }
   size_t processedCount() const { return processed_; }
   const std::map<std::string, size_t>& skippedCounts() const { return skipped_; }
+  // Scans registered with at least one degenerate direction (RegistrationResult::degeneracy).
+  size_t degenerateCount() const { return degenerate_; }
 
-  // A scan with fewer occupied pixels than this is skipped: nothing reliable can be registered.
-  static constexpr size_t kMinOccupiedPixels = 100;
+  // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
+  // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
+  // any real extent: a blocked or failing sensor, one ring, a fraction of a sweep. Registered anyway,
+  // such scans threw the pose off by metres with registration.degeneracy_threshold 0, by centimetres
+  // with the default (test/core/test_fault_cases.cpp). Healthy sweeps fill 57-78% of the image in every
+  // simulated world: 3 (VLP-16) to 17 (HDL-64E) times this.
+  size_t minOccupiedPixels() const;
 
  private:
   FrameResult skip(const std::string& reason);
+  // Forgets the model and the motion but keeps the pose: the next scan continues the trajectory from it.
+  void restartModel();
+  // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
+  void followTimeline(double stamp, FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;
+  std::string backend_warning_;
   MotionModel motion_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   bool started_ = false;
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
   size_t processed_ = 0;
+  size_t degenerate_ = 0;
   std::map<std::string, size_t> skipped_;
 };
 

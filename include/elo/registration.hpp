@@ -2,6 +2,7 @@
 #pragma once
 
 #include "elo/backend.hpp"
+#include "elo/degeneracy.hpp"
 
 namespace elo {
 
@@ -15,6 +16,10 @@ struct RegistrationResult {
   bool failed = false;
   double weight = 0.0;  // w = w1 * w2 of the last iteration
   NormalEquations last;  // the sums of the last iteration (inlier counts, errors)
+  // The directions the scan does not constrain (registration.degeneracy_threshold), decided at the
+  // initial guess, with the scaled eigenvalues of the Hessian that decided (see registration.cpp). Along
+  // a degenerate direction the estimate is the initial guess's.
+  Degeneracy degeneracy;
 };
 
 // w = w1 * w2. w2 compares the inlier ratios of the two terms: 1 while non-ground matching is at least
@@ -26,11 +31,13 @@ double fusionWeight(const NormalEquations& sums, const RegistrationConfig& confi
 // inlier count so that w keeps its meaning whatever the point counts.
 void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H, Vector6d& g);
 
-// The scale of the robust kernel over the iterations. Without an informed initial guess it starts at four
-// times `robust_kernel_scale` (at most the correspondence gate) and halves each iteration down to it,
-// jumping to the final one once the steps become small; with one it starts at the final scale. A tight kernel from the start would
-// ignore the very residuals a poor initial guess produces; a tight kernel at the end keeps edge
-// correspondences from biasing the solution.
+// The scale of the robust kernel over the iterations. Without an informed initial guess it starts at the
+// correspondence gate and halves each iteration down to `robust_kernel_scale`, jumping to the final one
+// once the steps become small; with one it starts at the final scale. A tight kernel from the start would
+// ignore the very residuals a poor initial guess produces: a start at 10 m/s is a metre from the
+// identity guess, mostly along facades that constrain it only through a few surfaces facing the motion
+// (test/pipeline/test_fault_drives.cpp). A tight kernel at the end keeps edge correspondences from
+// biasing the solution.
 class KernelSchedule {
  public:
   KernelSchedule(const RegistrationConfig& config, bool informed_guess);
@@ -41,12 +48,13 @@ class KernelSchedule {
   bool advance(bool step_was_small);
 
  private:
-  static constexpr double kStartFactor = 4.0;
   double final_;
   double scale_;
 };
 
-// `informed_guess`: the initial guess comes from a motion model with enough history to trust it.
+// `informed_guess`: the initial guess comes from a motion model with enough history to trust it. The
+// steps then solve only the directions the scan constrains (see degeneracy.hpp); along the others the
+// estimate keeps the initial guess. Without an informed guess every direction is solved.
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config);
 

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "elo/device_types.hpp"  // PixelLabel
+
 namespace elo {
 
 using Vec3f = Eigen::Vector3f;
@@ -22,7 +24,14 @@ struct PointCloud {
   size_t size() const { return points.size(); }
 };
 
-enum class PixelLabel : uint8_t { empty = 0, nonground = 1, ground = 2 };
+// The ring a reader stores for a driver's ring value. A value uint16 cannot hold (negative, or past
+// 65535, as a corrupt int32 field gives) would be undefined behaviour to convert; it becomes
+// kUnknownRing, a beam index no sensor has, so the projection drops that point like any other ring it
+// does not know.
+constexpr uint16_t kUnknownRing = 0xFFFF;
+inline uint16_t ringFromValue(double value) {
+  return value >= 0.0 && value < kUnknownRing ? static_cast<uint16_t>(value) : kUnknownRing;
+}
 
 // A spherical range image of vertices with their normals: the scan's non-ground features and the
 // non-ground model share it. A pixel is empty when its range is 0; it has no normal when its normal

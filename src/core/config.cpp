@@ -153,6 +153,9 @@ std::vector<Parameter> parameters(Config& c) {
            "pixels searched around the projective association"),
       bindField("registration.robust_kernel_scale", r.robust_kernel_scale,
                 "Geman-McClure scale for point-to-plane residuals, m; 0 = plain least squares"),
+      bindField("registration.degeneracy_threshold", r.degeneracy_threshold,
+                "share of the constraint below which a direction of motion is degenerate and keeps the motion "
+                "prior (scaled Hessian eigenvalue); 0 = off"),
       bindChoice("model.mode", m.mode,
                  {{RegistrationMode::frame_to_model, "frame_to_model"},
                   {RegistrationMode::frame_to_frame, "frame_to_frame"}},
@@ -165,6 +168,8 @@ std::vector<Parameter> parameters(Config& c) {
                  "initial guess of the registration (Sec. III-A)"),
       bindChoice("runtime.backend", c.runtime.backend,
                  {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
+      bindField("runtime.backend_fallback", c.runtime.backend_fallback,
+                "with backend cuda and no usable GPU, run on the CPU backend with a warning instead of failing"),
       bindField("runtime.threads", c.runtime.threads, "CPU threads, 0 = all"),
   };
 }
@@ -223,6 +228,10 @@ void validate(const Config& c) {
           "must lie in (0, 180]");
   require(r.association_radius >= 0, "registration.association_radius", "must not be negative");
   require(r.robust_kernel_scale >= 0.0, "registration.robust_kernel_scale", "must not be negative");
+  // The six scaled eigenvalues sum to 2, so the smallest is at most 1/3: a threshold that high would find
+  // every scan degenerate.
+  require(r.degeneracy_threshold >= 0.0 && r.degeneracy_threshold < 1.0 / 3.0, "registration.degeneracy_threshold",
+          "must lie in [0, 1/3)");
 
   require(c.model.time_window > 0.0, "model.time_window", "must be positive");
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");

@@ -18,4 +18,9 @@ void MotionModel::record(const Eigen::Isometry3d& increment, double dt) {
   history_ = history_ < 2 ? history_ + 1 : 2;
 }
 
+void MotionModel::holdVelocityAlong(const Matrix6d& projector) {
+  if (history_ < 2) return;
+  previous_velocity_ += projector * (latest_velocity_ - previous_velocity_);
+}
+
 }  // namespace elo

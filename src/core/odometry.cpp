@@ -17,14 +17,37 @@ double millisecondsSince(Clock::time_point start) {
 
 Odometry::Odometry(const Config& config) : config_(config), motion_(config.model.motion_prior) {
   validate(config_);
-  backend_ = makeBackend(config_);
+  backend_ = makeBackend(config_, &backend_warning_);
+}
+
+void Odometry::restartModel() {
+  backend_->resetModel();
+  motion_.reset();
+  started_ = false;
 }
 
 void Odometry::reset() {
-  backend_->resetModel();
-  motion_.reset();
+  restartModel();
   pose_ = Eigen::Isometry3d::Identity();
-  started_ = false;
+}
+
+void Odometry::followTimeline(double stamp, FrameResult& result) {
+  if (!started_) return;
+  if (stamp < last_stamp_) {
+    // A bag played in a loop, or a clock jump: the old model and motion describe another time.
+    reset();
+    result.reset = true;
+  } else if (stamp - last_stamp_ > config_.model.time_window) {
+    // Every model point is older than tau_w, and no motion prior holds for that long: registering
+    // against the stale model from an extrapolated guess could converge anywhere. Carry on from the
+    // last pose with a new model instead; the pose does not jump, and the caller is told.
+    restartModel();
+    result.gap_restart = true;
+  }
+}
+
+size_t Odometry::minOccupiedPixels() const {
+  return static_cast<size_t>(config_.normals.min_window_height) * static_cast<size_t>(config_.sensor.image_width);
 }
 
 FrameResult Odometry::skip(const std::string& reason) {
@@ -38,27 +61,22 @@ FrameResult Odometry::skip(const std::string& reason) {
 FrameResult Odometry::process(const PointCloud& cloud) {
   if (cloud.points.empty()) return skip("empty cloud");
   if (!std::isfinite(cloud.stamp)) return skip("stamp not finite");
-  bool restarted = false;
   if (started_ && cloud.stamp == last_stamp_) return skip("duplicate stamp");
-  if (started_ && cloud.stamp < last_stamp_) {
-    // A bag played in a loop, or a clock jump: the old model and motion describe another time.
-    reset();
-    restarted = true;
-  }
+  FrameResult result;
+  followTimeline(cloud.stamp, result);
   if (!started_) first_stamp_ = cloud.stamp;
 
   const auto frame_start = Clock::now();
-  FrameResult result;
-  result.reset = restarted;
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
   const float relative_stamp = static_cast<float>(cloud.stamp - first_stamp_);
 
   auto stage_start = Clock::now();
   const size_t occupied = backend_->projectScan(cloud, relative_stamp);
   result.times.projection = millisecondsSince(stage_start);
-  if (occupied < kMinOccupiedPixels) {
+  if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
-    skipped.reset = restarted;
+    skipped.reset = result.reset;
+    skipped.gap_restart = result.gap_restart;
     return skipped;
   }
 
@@ -66,6 +84,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   backend_->segmentGround();
   backend_->estimateNormals();
   backend_->buildGroundMap();
+  backend_->synchronize();  // a device backend's stages run on after the calls return
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
@@ -76,10 +95,16 @@ FrameResult Odometry::process(const PointCloud& cloud) {
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;
     motion_.record(result.delta, dt);
+    const Degeneracy& degeneracy = result.registration.degeneracy;
+    if (degeneracy.any()) {
+      ++degenerate_;
+      motion_.holdVelocityAlong(degeneracy.degenerateProjector());
+    }
   }
 
   stage_start = Clock::now();
   backend_->updateModel(result.delta, relative_stamp);
+  backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);
 
   started_ = true;

@@ -1,7 +1,7 @@
 #include "elo/registration.hpp"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
+#include <optional>
 
 namespace elo {
 
@@ -51,8 +51,7 @@ void fuseNormalEquations(const NormalEquations& sums, double weight, Matrix6d& H
 KernelSchedule::KernelSchedule(const RegistrationConfig& config, bool informed_guess)
     : final_(config.robust_kernel_scale),
       scale_(informed_guess ? config.robust_kernel_scale
-                            : std::min(config.max_correspondence_distance,
-                                       kStartFactor * config.robust_kernel_scale)) {}
+                            : std::max(config.max_correspondence_distance, config.robust_kernel_scale)) {}
 
 bool KernelSchedule::advance(bool step_was_small) {
   if (step_was_small) {
@@ -64,32 +63,72 @@ bool KernelSchedule::advance(bool step_was_small) {
   return false;
 }
 
+namespace {
+
+// The directions the registration keeps at the initial guess, decided once per scan from the first
+// iteration's Hessian `weighted` (linearised at the guess); nullopt when the scene constrains no
+// translation or no rotation at all. Keeping them fixed over the iterations keeps the estimate's
+// component along them exactly the guess's (up to the curvature of SE(3)).
+//
+// The robust kernel makes the weighted Hessian depend on how far off the guess is: the correspondences
+// that would pull along a direction the guess has wrong carry large residuals and little weight, so the
+// direction looks degenerate, is kept, stays wrong, and looks degenerate again on the next scan
+// (measured: a drive accelerating along a sparse approach road locked at constant velocity and ended
+// 75 m behind). A flagged direction is therefore confirmed on the geometry alone: the unweighted sums of
+// the same correspondences, within the correspondence gate. That costs one linearisation more, on
+// flagged scans only.
+std::optional<Degeneracy> keptDirections(Backend& backend, const Eigen::Isometry3d& guess, const Matrix6d& weighted,
+                                         double threshold, const RegistrationConfig& config) {
+  const std::optional<Degeneracy> flagged = analyseDegeneracy(weighted, threshold);
+  if (!flagged || !flagged->any()) return flagged;
+  const NormalEquations geometry = backend.linearize(guess, 0.0);
+  Matrix6d hessian;
+  Vector6d unused_gradient;
+  fuseNormalEquations(geometry, fusionWeight(geometry, config), hessian, unused_gradient);
+  return analyseDegeneracy(hessian, threshold);
+}
+
+// The Gauss-Newton step of one iteration within the kept directions, deciding them on the first; nullopt
+// when there is no step to trust: fewer than six constraints, no translation or rotation constraint at
+// all, or a Hessian that is singular within the constrained directions.
+std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const Vector6d& gradient,
+                                        double degeneracy_threshold, const RegistrationConfig& config,
+                                        RegistrationResult& result) {
+  if (result.last.nonground.inliers + result.last.ground.inliers < 6) return std::nullopt;
+  if (iteration == 0) {
+    const std::optional<Degeneracy> kept =
+        keptDirections(backend, result.model_from_scan, result.hessian, degeneracy_threshold, config);
+    if (!kept) return std::nullopt;
+    result.degeneracy = *kept;
+  }
+  return constrainedStep(result.degeneracy, result.hessian, gradient);
+}
+
+}  // namespace
+
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
   KernelSchedule kernel(config, informed_guess);
+  // Without an informed guess there is no prior worth keeping, and the guess may be a metre off (a start
+  // at speed), beyond the correspondence gate along a direction the scene constrains only through a few
+  // surfaces. Every direction is solved, as with the handling off.
+  const double degeneracy_threshold = informed_guess ? config.degeneracy_threshold : 0.0;
   Vector6d g;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     result.last = backend.linearize(result.model_from_scan, kernel.scale());
     result.weight = fusionWeight(result.last, config);
     fuseNormalEquations(result.last, result.weight, result.hessian, g);
     result.iterations = iteration + 1;
-    const Eigen::LDLT<Matrix6d> solver(result.hessian);
-    // Fewer than six constraints, or a Hessian that is not positive definite, give no step to trust.
-    if (result.last.nonground.inliers + result.last.ground.inliers < 6 || solver.info() != Eigen::Success ||
-        !solver.isPositive()) {
+    const std::optional<Vector6d> step = gaussNewtonStep(backend, iteration, g, degeneracy_threshold, config, result);
+    if (!step) {
       result.failed = true;
       return result;
     }
-    const Vector6d step = -solver.solve(g);
-    if (!step.allFinite()) {
-      result.failed = true;
-      return result;
-    }
-    result.model_from_scan = expSE3(step) * result.model_from_scan;
-    const bool small = step.head<3>().norm() < config.converged_translation &&
-                       step.tail<3>().norm() < config.converged_rotation;
+    result.model_from_scan = expSE3(*step) * result.model_from_scan;
+    const bool small = step->head<3>().norm() < config.converged_translation &&
+                       step->tail<3>().norm() < config.converged_rotation;
     if (kernel.advance(small)) {
       result.converged = true;
       break;

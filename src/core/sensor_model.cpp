@@ -27,6 +27,14 @@ BevProjection BevProjection::fromConfig(const BevConfig& bev) {
   return projection;
 }
 
+ElevationCorrection ElevationCorrection::fromConfig(const SensorConfig& sensor) {
+  ElevationCorrection correction;
+  correction.active = sensor.elevation_correction_deg != 0.0;
+  correction.cos_angle = static_cast<float>(std::cos(sensor.elevation_correction_deg * kDegToRad));
+  correction.sin_angle = static_cast<float>(std::sin(sensor.elevation_correction_deg * kDegToRad));
+  return correction;
+}
+
 std::vector<float> beamElevations(const SensorConfig& sensor) {
   std::vector<float> elevations;
   if (!sensor.beam_elevations_deg.empty()) {

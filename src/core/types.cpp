@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/common/eigen_interop.hpp"
+
 namespace elo {
 
 void SphericalImage::resize(int image_rows, int image_cols) {
@@ -48,7 +50,7 @@ void BevImage::clear() {
 }
 
 void BevImage::keepCloser(int32_t grid_cell, const Vec3f& point, float point_stamp) {
-  const float point_range = point.norm();
+  const float point_range = norm(toFloat3(point));  // the range the CUDA backend computes
   int32_t& index = point_of_cell[grid_cell];
   if (index < 0) {
     index = static_cast<int32_t>(vertex.size());

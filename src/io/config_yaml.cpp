@@ -32,17 +32,23 @@ std::string expectedType(const ParameterValue& value) {
 }
 
 // The YAML value as the alternative the parameter holds now, so that `5` sets a double parameter and
-// `5.5` is refused for an integer one; nullopt when the value does not convert.
+// `5.5` is refused for an integer one; nullopt when the value does not convert. yaml-cpp decodes a
+// sequence element by element with as<>(), which throws for an element that is not a number (`[1, 2x]`)
+// instead of reporting failure; that too is a value that does not convert.
 std::optional<ParameterValue> convertToCurrentType(const YAML::Node& node, const ParameterValue& current) {
   return std::visit(
       [&node](const auto& current_value) -> std::optional<ParameterValue> {
         using T = std::decay_t<decltype(current_value)>;
         const bool shape_matches = std::is_same_v<T, std::vector<double>> ? node.IsSequence() : node.IsScalar();
         T converted;
-        if (shape_matches && YAML::convert<T>::decode(node, converted)) {
-          return converted;
+        try {
+          if (shape_matches && YAML::convert<T>::decode(node, converted)) {
+            return converted;
+          }
+          return std::nullopt;
+        } catch (const YAML::BadConversion&) {
+          return std::nullopt;
         }
-        return std::nullopt;
       },
       current);
 }
@@ -64,7 +70,11 @@ void setParameter(const Parameter& parameter, const YAML::Node& node, const std:
 void loadSection(const YAML::Node& section, const std::string& prefix, const ParameterTable& table,
                  const std::string& path) {
   for (const auto& entry : section) {
-    const std::string key = prefix + entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) {  // `[a]: 1` or `? {a: 1}`: YAML allows it, a parameter path does not
+      throw ConfigError(location(path, entry.first) + ": expected a parameter or section name, got a " +
+                        (entry.first.IsNull() ? "null" : "sequence or map") + " as key");
+    }
+    const std::string key = prefix + entry.first.Scalar();
     const auto parameter = table.find(key);
     if (entry.second.IsMap() && parameter == table.end()) {
       loadSection(entry.second, key + ".", table, path);
@@ -76,13 +86,11 @@ void loadSection(const YAML::Node& section, const std::string& prefix, const Par
   }
 }
 
-YAML::Node parseYamlFile(const std::string& path) {
+YAML::Node parseYaml(std::istream& stream, const std::string& name) {
   try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw IoError("cannot open '" + path + "' for reading");
+    return YAML::Load(stream);
   } catch (const YAML::ParserException& error) {
-    throw IoError(path + ":" + std::to_string(error.mark.line + 1) + ": invalid YAML: " + error.msg);
+    throw IoError(name + ":" + std::to_string(error.mark.line + 1) + ": invalid YAML: " + error.msg);
   }
 }
 
@@ -161,20 +169,25 @@ void emitSection(YAML::Emitter& out, const YamlEntry& section) {
 }  // namespace
 
 void loadConfigYaml(const std::string& path, Config& config) {
-  const YAML::Node root = parseYamlFile(path);
+  std::ifstream stream = io_detail::openForReading(path);
+  loadConfigYaml(stream, path, config);
+}
+
+void loadConfigYaml(std::istream& stream, const std::string& name, Config& config) {
+  const YAML::Node root = parseYaml(stream, name);
   if (!root.IsNull() && !root.IsMap()) {  // an empty file keeps every default
-    throw ConfigError(path + ": the top level must be a map of parameter sections");
+    throw ConfigError(name + ": the top level must be a map of parameter sections");
   }
   const std::vector<Parameter> table_entries = parameters(config);
   ParameterTable table;
   for (const Parameter& parameter : table_entries) {
     table.emplace(parameter.key, &parameter);
   }
-  loadSection(root, "", table, path);
+  loadSection(root, "", table, name);
   try {
     validate(config);
   } catch (const ConfigError& error) {
-    throw ConfigError(path + ": " + error.what());
+    throw ConfigError(name + ": " + error.what());
   }
 }
 

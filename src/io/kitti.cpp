@@ -46,22 +46,38 @@ std::vector<Eigen::Isometry3d> conjugate(const std::vector<Eigen::Isometry3d>& p
   return result;
 }
 
+// The bytes from the stream's position to its end, leaving the position where it was.
+size_t bytesToEnd(std::istream& stream, const std::string& name) {
+  const std::streampos start = stream.tellg();
+  stream.seekg(0, std::ios::end);
+  const std::streampos end = stream.tellg();
+  stream.seekg(start);
+  if (start < 0 || end < start || !stream) {
+    throw IoError("cannot read the size of '" + name + "': the stream cannot seek");
+  }
+  return static_cast<size_t>(end - start);
+}
+
 }  // namespace
 
 PointCloud readKittiBin(const std::string& path) {
   std::ifstream stream = io_detail::openForReading(path, std::ios::binary);
-  std::error_code error;
-  const auto bytes = static_cast<size_t>(std::filesystem::file_size(path, error));
-  if (error) {
-    throw IoError("cannot read the size of '" + path + "': " + error.message());
+  // A directory opens and seeks like a file of 2^63 bytes: refuse it before sizing a buffer by it.
+  if (!std::filesystem::is_regular_file(path)) {
+    throw IoError("cannot read '" + path + "': not a regular file");
   }
+  return readKittiBin(stream, path);
+}
+
+PointCloud readKittiBin(std::istream& stream, const std::string& name) {
+  const size_t bytes = bytesToEnd(stream, name);
   if (bytes % kBinBytesPerPoint != 0) {
-    throw IoError("'" + path + "' is not a KITTI scan: its size (" + std::to_string(bytes) +
+    throw IoError("'" + name + "' is not a KITTI scan: its size (" + std::to_string(bytes) +
                   " bytes) is not a multiple of 16 (x, y, z, intensity as float32)");
   }
   std::vector<float> values(bytes / sizeof(float));
   if (!stream.read(reinterpret_cast<char*>(values.data()), static_cast<std::streamsize>(bytes))) {
-    throw IoError("reading '" + path + "' failed after " + std::to_string(stream.gcount()) + " bytes");
+    throw IoError("reading '" + name + "' failed after " + std::to_string(stream.gcount()) + " bytes");
   }
   PointCloud cloud;
   const size_t count = bytes / kBinBytesPerPoint;
@@ -90,8 +106,13 @@ void writeKittiBin(const std::string& path, const PointCloud& cloud) {
 }
 
 std::vector<double> readTimes(const std::string& path) {
+  std::ifstream stream = io_detail::openForReading(path);
+  return readTimes(stream, path);
+}
+
+std::vector<double> readTimes(std::istream& stream, const std::string& name) {
   std::vector<double> stamps;
-  for (const std::vector<double>& row : io_detail::readNumberRows(path, 1)) {
+  for (const std::vector<double>& row : io_detail::readNumberRows(stream, name, 1)) {
     stamps.push_back(row[0]);
   }
   return stamps;
@@ -106,8 +127,13 @@ void writeTimes(const std::string& path, const std::vector<double>& stamps) {
 }
 
 std::vector<Eigen::Isometry3d> readKittiPoses(const std::string& path) {
+  std::ifstream stream = io_detail::openForReading(path);
+  return readKittiPoses(stream, path);
+}
+
+std::vector<Eigen::Isometry3d> readKittiPoses(std::istream& stream, const std::string& name) {
   std::vector<Eigen::Isometry3d> poses;
-  for (const std::vector<double>& row : io_detail::readNumberRows(path, kPoseMatrixEntries)) {
+  for (const std::vector<double>& row : io_detail::readNumberRows(stream, name, kPoseMatrixEntries)) {
     poses.push_back(poseFromRowMajor3x4(row));
   }
   return poses;
@@ -122,8 +148,14 @@ void writeKittiPoses(const std::string& path, const std::vector<Eigen::Isometry3
 }
 
 std::vector<Eigen::Isometry3d> readTumPoses(const std::string& path, std::vector<double>* stamps) {
+  std::ifstream stream = io_detail::openForReading(path);
+  return readTumPoses(stream, path, stamps);
+}
+
+std::vector<Eigen::Isometry3d> readTumPoses(std::istream& stream, const std::string& name,
+                                            std::vector<double>* stamps) {
   std::vector<Eigen::Isometry3d> poses;
-  for (const std::vector<double>& row : io_detail::readNumberRows(path, 8)) {
+  for (const std::vector<double>& row : io_detail::readNumberRows(stream, name, 8)) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.translation() = Eigen::Vector3d(row[1], row[2], row[3]);
     pose.linear() = Eigen::Quaterniond(row[7], row[4], row[5], row[6]).normalized().toRotationMatrix();
@@ -152,6 +184,10 @@ void writeTumPoses(const std::string& path, const std::vector<double>& stamps,
 
 Eigen::Isometry3d readKittiCalibration(const std::string& path) {
   std::ifstream stream = io_detail::openForReading(path);
+  return readKittiCalibration(stream, path);
+}
+
+Eigen::Isometry3d readKittiCalibration(std::istream& stream, const std::string& name) {
   std::string line;
   for (size_t line_number = 1; std::getline(stream, line); ++line_number) {
     const size_t colon = line.find(':');
@@ -159,14 +195,14 @@ Eigen::Isometry3d readKittiCalibration(const std::string& path) {
     if (colon == std::string::npos || (label != "Tr" && label != "Tr_velo_to_cam")) {
       continue;
     }
-    const std::vector<double> entries = io_detail::parseNumbers(line.substr(colon + 1), path, line_number);
+    const std::vector<double> entries = io_detail::parseNumbers(line.substr(colon + 1), name, line_number);
     if (entries.size() != kPoseMatrixEntries) {
-      throw IoError(path + ":" + std::to_string(line_number) + ": " + label + " needs 12 numbers, found " +
+      throw IoError(name + ":" + std::to_string(line_number) + ": " + label + " needs 12 numbers, found " +
                     std::to_string(entries.size()));
     }
     return poseFromRowMajor3x4(entries);
   }
-  throw IoError("'" + path + "' has no 'Tr:' (or 'Tr_velo_to_cam:') line");
+  throw IoError("'" + name + "' has no 'Tr:' (or 'Tr_velo_to_cam:') line");
 }
 
 void writeKittiCalibration(const std::string& path, const Eigen::Isometry3d& velo_to_cam) {

@@ -10,14 +10,16 @@
 #include <optional>
 
 #include "elo/io/io_error.hpp"
+#include "pcd_format.hpp"
+#include "text_format.hpp"
 
 namespace elo {
 namespace {
 
 using pcl::PCLPointField;
 
-std::optional<PCLPointField> findField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
-  for (const PCLPointField& field : cloud.fields) {
+std::optional<PCLPointField> findField(const std::vector<PCLPointField>& fields, const std::string& name) {
+  for (const PCLPointField& field : fields) {
     if (field.name == name) {
       return field;
     }
@@ -60,25 +62,25 @@ struct FieldLayout {
   double time_scale = 1.0;  // seconds per stored unit
 };
 
-FieldLayout findLayout(const pcl::PCLPointCloud2& cloud, const std::string& path) {
+FieldLayout findLayout(const std::vector<PCLPointField>& fields, const std::string& path) {
   FieldLayout layout;
   PCLPointField* coordinates[] = {&layout.x, &layout.y, &layout.z};
   const char* names[] = {"x", "y", "z"};
   for (int axis = 0; axis < 3; ++axis) {
-    const std::optional<PCLPointField> field = findField(cloud, names[axis]);
+    const std::optional<PCLPointField> field = findField(fields, names[axis]);
     if (!field || !isFloatingPoint(field->datatype)) {
       throw IoError("'" + path + "' needs a float32 or float64 field '" + names[axis] + "'");
     }
     *coordinates[axis] = *field;
   }
-  layout.intensity = findField(cloud, "intensity");
-  layout.ring = findField(cloud, "ring");
+  layout.intensity = findField(fields, "intensity");
+  layout.ring = findField(fields, "ring");
   if (layout.ring && isFloatingPoint(layout.ring->datatype)) {
     throw IoError("'" + path + "': field 'ring' must be an integer type");
   }
-  layout.time = findField(cloud, "time");
+  layout.time = findField(fields, "time");
   if (!layout.time) {
-    layout.time = findField(cloud, "t");
+    layout.time = findField(fields, "t");
   }
   if (layout.time && !isFloatingPoint(layout.time->datatype)) {
     layout.time_scale = 1e-9;  // integer times are nanoseconds (Ouster)
@@ -101,7 +103,7 @@ void appendPoint(const uint8_t* point, const Vec3f& position, const FieldLayout&
         static_cast<float>(readScalar(point + layout.intensity->offset, layout.intensity->datatype)));
   }
   if (layout.ring) {
-    cloud.ring.push_back(static_cast<uint16_t>(readScalar(point + layout.ring->offset, layout.ring->datatype)));
+    cloud.ring.push_back(ringFromValue(readScalar(point + layout.ring->offset, layout.ring->datatype)));
   }
   if (layout.time) {
     cloud.time.push_back(static_cast<float>(
@@ -124,31 +126,32 @@ void writeScalar(uint8_t* point, const PCLPointField& field, T value) {
   std::memcpy(point + field.offset, &value, sizeof(T));
 }
 
+// The whole file in one read: a scan is a few MB, and the parser checks its sizes against it.
+std::string readFileBytes(const std::string& path) {
+  std::ifstream stream = io_detail::openForReading(path, std::ios::binary);
+  std::error_code error;
+  const auto size = static_cast<size_t>(std::filesystem::file_size(path, error));
+  if (error) {
+    throw IoError("cannot read the size of '" + path + "': " + error.message());
+  }
+  std::string bytes(size, '\0');
+  if (!stream.read(bytes.data(), static_cast<std::streamsize>(size))) {
+    throw IoError("reading '" + path + "' failed after " + std::to_string(stream.gcount()) + " bytes");
+  }
+  return bytes;
+}
+
 }  // namespace
 
 PointCloud readPcd(const std::string& path, size_t* non_finite_skipped) {
   if (!std::filesystem::is_regular_file(path)) {
     throw IoError("cannot read '" + path + "': no such file");
   }
-  // The header first: PCL 1.13 accepts a header without FIELDS and then crashes reading the body.
-  pcl::PCDReader reader;
-  pcl::PCLPointCloud2 pcd;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0;
-  int data_type = 0;
-  unsigned int data_offset = 0;
-  if (reader.readHeader(path, pcd, origin, orientation, version, data_type, data_offset) != 0 || pcd.fields.empty()) {
-    throw IoError("cannot read '" + path + "': not a PCD file (no valid header with FIELDS)");
-  }
-  const FieldLayout layout = findLayout(pcd, path);
-  if (reader.read(path, pcd) != 0) {
-    throw IoError("cannot read '" + path + "': PCL could not parse its points");
-  }
-  const size_t count = static_cast<size_t>(pcd.width) * pcd.height;
+  const io_detail::PcdPoints pcd = io_detail::parsePcd(readFileBytes(path), path);
+  const FieldLayout layout = findLayout(pcd.fields, path);
   PointCloud cloud;
   size_t skipped = 0;
-  for (size_t i = 0; i < count; ++i) {
+  for (size_t i = 0; i < pcd.count; ++i) {
     const uint8_t* point = pcd.data.data() + i * pcd.point_step;
     const Vec3f position = readPosition(point, layout);
     if (position.allFinite()) {

@@ -66,17 +66,16 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& pat
   return numbers;
 }
 
-std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t columns) {
-  std::ifstream stream = openForReading(path);
+std::vector<std::vector<double>> readNumberRows(std::istream& stream, const std::string& name, size_t columns) {
   std::vector<std::vector<double>> rows;
   std::string line;
   for (size_t line_number = 1; std::getline(stream, line); ++line_number) {
-    std::vector<double> numbers = parseNumbers(line, path, line_number);
+    std::vector<double> numbers = parseNumbers(line, name, line_number);
     if (numbers.empty()) {
       continue;  // blank lines, such as a trailing one, carry no frame
     }
     if (numbers.size() != columns) {
-      throw IoError(path + ":" + std::to_string(line_number) + ": expected " + std::to_string(columns) +
+      throw IoError(name + ":" + std::to_string(line_number) + ": expected " + std::to_string(columns) +
                     " numbers, found " + std::to_string(numbers.size()));
     }
     rows.push_back(std::move(numbers));

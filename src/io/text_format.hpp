@@ -23,8 +23,8 @@ std::string formatDoubles(const std::vector<double>& values);
 // first token that is not a number.
 std::vector<double> parseNumbers(const std::string& text, const std::string& path, size_t line_number);
 
-// Every non-blank line of a text file as `columns` numbers; throws IoError naming the file and the
-// line of a row with another count or a token that is not a number.
-std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t columns);
+// Every non-blank line of a text stream as `columns` numbers; throws IoError naming `name` (the file)
+// and the line of a row with another count or a token that is not a number.
+std::vector<std::vector<double>> readNumberRows(std::istream& stream, const std::string& name, size_t columns);
 
 }  // namespace elo::io_detail

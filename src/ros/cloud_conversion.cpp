@@ -178,7 +178,7 @@ elo::Vec3f readPosition(const uint8_t* point, const Layout& layout) {
 void appendPoint(const uint8_t* point, const elo::Vec3f& position, const Layout& layout, elo::PointCloud& cloud) {
   cloud.points.push_back(position);
   if (layout.intensity) cloud.intensity.push_back(static_cast<float>(layout.intensity->read(point)));
-  if (layout.ring) cloud.ring.push_back(static_cast<uint16_t>(layout.ring->read(point)));
+  if (layout.ring) cloud.ring.push_back(elo::ringFromValue(layout.ring->read(point)));
   if (layout.time) cloud.time.push_back(static_cast<float>(layout.time_scale * layout.time->read(point)));
 }
 

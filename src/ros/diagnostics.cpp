@@ -22,6 +22,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(rejected, "rejected");
   add(skipped, "skipped");
   add(failed_registrations, "registrations failed");
+  add(restarts, "odometry restarts");
   return text.str();
 }
 
@@ -51,6 +52,12 @@ void PipelineStatistics::scanSkipped(const std::string& reason) {
   ++window_.skipped;
 }
 
+void PipelineStatistics::odometryRestarted(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++restarts_[reason];
+  ++window_.restarts;
+}
+
 void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double latency_ms) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++processed_;
@@ -63,6 +70,9 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
     ++failed_registrations_;
     ++window_.failed_registrations;
   }
+  if (result.registration.degeneracy.any()) {
+    ++degenerate_scans_;
+  }
   if (result.registration.iterations > 0) last_registration_ = result.registration;
 }
 
@@ -72,7 +82,13 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   const double seconds = std::chrono::duration<double>(now - window_start_).count();
   const Window& w = window_;
 
-  const std::string problems = w.problems();
+  std::string problems = w.problems();
+  // Only the latest scan: a degenerate scan now and then on an open road needs no alarm, a run of them
+  // (a tunnel) warns for as long as it lasts.
+  const elo::Degeneracy& degeneracy = last_registration_.degeneracy;
+  if (degeneracy.any()) {
+    problems += (problems.empty() ? "" : ", ") + std::string("latest scan degenerate along ") + degeneracy.describe();
+  }
   if (problems.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   } else {
@@ -89,12 +105,17 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("ground inlier ratio", last.ground.inlierRatio());
   status.add("fusion weight", last_registration_.weight);
   status.add("registration iterations", last_registration_.iterations);
+  // Share of the constraint along the least constrained direction (see elo/degeneracy.hpp).
+  status.add("smallest constraint eigenvalue", degeneracy.eigenvalues[0]);
+  status.add("degenerate directions", degeneracy.any() ? degeneracy.describe() : "none");
   status.add("clouds received", received_);
   status.add("scans processed", processed_);
   status.add("scans dropped", dropped_);
   status.add("registrations failed", failed_registrations_);
+  status.add("scans degenerate", degenerate_scans_);
   for (const auto& [reason, count] : rejected_) status.add("clouds rejected: " + reason, count);
   for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
+  for (const auto& [reason, count] : restarts_) status.add("odometry restarts: " + reason, count);
 
   window_start_ = now;
   window_ = Window();

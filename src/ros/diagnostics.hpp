@@ -26,9 +26,11 @@ class PipelineStatistics {
   void scanSkipped(const std::string& reason);
   // `latency_ms`: from the cloud's arrival to its odometry being published, queueing included.
   void scanProcessed(const elo::FrameResult& result, double latency_ms);
+  // The odometry restarted at a scan (processed or skipped); `reason` groups the counts.
+  void odometryRestarted(const std::string& reason);
 
   // Fills `status` and starts a new window. WARN when the window saw no cloud at all, or a drop,
-  // rejection, skip or failed registration.
+  // rejection, skip, restart or failed registration, and while the latest scan is degenerate.
   void report(diagnostic_updater::DiagnosticStatusWrapper& status);
 
  private:
@@ -41,6 +43,7 @@ class PipelineStatistics {
     size_t rejected = 0;
     size_t skipped = 0;
     size_t failed_registrations = 0;
+    size_t restarts = 0;
     double processing_ms_sum = 0.0;
     double processing_ms_max = 0.0;
     double latency_ms_sum = 0.0;
@@ -57,8 +60,10 @@ class PipelineStatistics {
   size_t processed_ = 0;
   size_t dropped_ = 0;
   size_t failed_registrations_ = 0;
+  size_t degenerate_scans_ = 0;
   std::map<std::string, size_t> rejected_;
   std::map<std::string, size_t> skipped_;
+  std::map<std::string, size_t> restarts_;
   elo::RegistrationResult last_registration_;
 };
 

@@ -114,6 +114,11 @@ elo::PointCloud modelPoints(const elo::Model& model, const Eigen::Isometry3d& tr
   return cloud;
 }
 
+// Along a degenerate direction the estimate is the motion prior's, which nothing in the scan checks: a
+// standard deviation of 1 m per scan (for the rotation part of a direction, the angle that sweeps 1 m at
+// the registration's lever arm) tells a downstream filter to take that direction from another sensor.
+constexpr double kDegeneratePriorStddev = 1.0;  // m
+
 std::optional<elo::Matrix6d> registrationCovariance(const elo::RegistrationResult& registration) {
   const elo::TermSums& nonground = registration.last.nonground;
   const elo::TermSums& ground = registration.last.ground;
@@ -124,8 +129,14 @@ std::optional<elo::Matrix6d> registrationCovariance(const elo::RegistrationResul
   double variance = 0.0;
   if (nonground.inliers > 0) variance += w * nonground.squared_error / nonground.inliers;
   if (ground.inliers > 0) variance += (1.0 - w) * ground.squared_error / ground.inliers;
+  if (registration.degeneracy.any()) {
+    const elo::Matrix6d covariance = registration.degeneracy.covariance(
+        registration.hessian, variance / inliers, kDegeneratePriorStddev * kDegeneratePriorStddev);
+    if (!covariance.allFinite()) return std::nullopt;
+    return covariance;
+  }
   // Cholesky, unlike LDLT, fails on a semi-definite Hessian: a direction the scan does not constrain
-  // has no finite covariance.
+  // (and the registration did not report) has no finite covariance.
   const Eigen::LLT<elo::Matrix6d> solver(registration.hessian);
   if (solver.info() != Eigen::Success) return std::nullopt;
   // Column by column: a matrix right-hand side takes Eigen's blocked GEMM path, meant for large matrices.

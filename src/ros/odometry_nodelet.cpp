@@ -29,6 +29,7 @@ void OdometryNodelet::onInit() {
     NODELET_FATAL("cannot start: %s", error.what());
     throw;
   }
+  if (!odometry_->backendWarning().empty()) NODELET_WARN("%s", odometry_->backendWarning().c_str());
   if (!settings_.publish_sensor_frame_directly) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, getNodeHandle());
@@ -165,10 +166,7 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
 
   std::unique_lock<std::mutex> lock(odometry_mutex_);
   const elo::FrameResult result = odometry_->process(converted.cloud);
-  if (result.reset) {
-    NODELET_WARN("time went backwards (a bag replayed again?): the odometry restarted");
-    forgetTrajectory();
-  }
+  reportRestart(result, converted.cloud.stamp);
   // Every scan the core saw, a skipped one repeating the last pose: the lines match elo_run's.
   trajectory_stamps_.push_back(converted.cloud.stamp);
   trajectory_poses_.push_back(result.pose);
@@ -190,6 +188,20 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   if (ros::ok()) publish(messages);
   const double latency_ms = std::chrono::duration<double, std::milli>(Clock::now() - queued.received).count();
   statistics_.scanProcessed(result, latency_ms);
+}
+
+void OdometryNodelet::reportRestart(const elo::FrameResult& result, double stamp) {
+  if (result.reset) {
+    NODELET_WARN("time went backwards (a bag replayed again?): the odometry restarted at the origin");
+    statistics_.odometryRestarted("time went backwards");
+    forgetTrajectory();
+  }
+  if (result.gap_restart) {
+    NODELET_WARN("no scan for %.1f s, longer than model.time_window (%.1f s): the model restarted at the last pose, "
+                 "and the odometry leaves out the motion during the gap",
+                 stamp - last_processed_stamp_.value_or(stamp), odometry_->config().model.time_window);
+    statistics_.odometryRestarted("gap longer than model.time_window");
+  }
 }
 
 OdometryNodelet::ScanMessages OdometryNodelet::buildMessages(const elo::FrameResult& result, double dt,

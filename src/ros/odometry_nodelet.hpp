@@ -52,6 +52,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   // Looks up the sensor -> base extrinsic for the first cloud's frame; false (and the cloud rejected)
   // while it is unknown, or when a cloud arrives in another frame.
   bool bindFrames(const std::string& sensor_frame);
+  // Warns and counts when the odometry restarted at this scan; a reset also forgets the trajectory.
+  void reportRestart(const elo::FrameResult& result, double stamp);
   ScanMessages buildMessages(const elo::FrameResult& result, double dt, const std_msgs::Header& header);
   void publish(const ScanMessages& messages);
   void forgetTrajectory();

@@ -117,6 +117,19 @@ std::vector<std::string> unknownSectionMembers(XmlRpcValue& tree, const std::vec
   return unknown;
 }
 
+const char* expectedType(bool) { return "true or false"; }
+const char* expectedType(int) { return "an integer"; }
+const char* expectedType(double) { return "a number"; }
+const char* expectedType(const std::string&) { return "a string"; }
+
+// Reads `~name` into `value` when it is set. A value of another type is an error: quietly keeping the
+// default would run the node with a setting nobody chose.
+template <typename T>
+void readSetting(const ros::NodeHandle& private_node, const std::string& name, T& value) {
+  if (!private_node.hasParam(name)) return;
+  if (!private_node.getParam(name, value)) throw std::invalid_argument("~" + name + " must be " + expectedType(value));
+}
+
 }  // namespace
 
 std::vector<std::string> applyConfigParameters(XmlRpcValue tree, elo::Config& config) {
@@ -144,7 +157,7 @@ std::vector<std::pair<std::string, XmlRpcValue>> effectiveParameters(elo::Config
 
 NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {
   NodeSettings settings;
-  const auto read = [&](const std::string& name, auto& value) { private_node.param(name, value, value); };
+  const auto read = [&](const std::string& name, auto& value) { readSetting(private_node, name, value); };
   read("odom_frame", settings.odom_frame);
   read("base_frame", settings.base_frame);
   read("publish_sensor_frame_directly", settings.publish_sensor_frame_directly);
@@ -166,9 +179,9 @@ NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {
 
 OutputFiles readOutputFiles(const ros::NodeHandle& private_node) {
   OutputFiles files;
-  private_node.param("trajectory_file", files.trajectory_file, files.trajectory_file);
-  private_node.param("trajectory_format", files.trajectory_format, files.trajectory_format);
-  private_node.param("map_file", files.map_file, files.map_file);
+  readSetting(private_node, "trajectory_file", files.trajectory_file);
+  readSetting(private_node, "trajectory_format", files.trajectory_format);
+  readSetting(private_node, "map_file", files.map_file);
   return files;
 }
 

@@ -54,7 +54,7 @@ struct NodeSettings {
 };
 
 // Reads the settings from the private namespace. Throws std::invalid_argument naming a parameter whose
-// value cannot work.
+// value cannot work or has the wrong type.
 NodeSettings readNodeSettings(const ros::NodeHandle& private_node);
 
 OutputFiles readOutputFiles(const ros::NodeHandle& private_node);

@@ -1,10 +1,11 @@
 #include "elo/sim/sequence_writer.hpp"
 
-#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
-#include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "elo/io/io_error.hpp"
@@ -21,7 +22,7 @@ std::string scanPath(const std::filesystem::path& velodyne, int frame) {
 
 }  // namespace
 
-SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory) {
+SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory, const ScanSink& sink) {
   const std::filesystem::path root(directory);
   const std::filesystem::path velodyne = root / "velodyne";
   std::error_code error;
@@ -29,23 +30,42 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
   if (error) throw IoError("cannot create '" + velodyne.string() + "': " + error.message());
 
   const int frames = simulation.frameCount();
+  const Eigen::Isometry3d first_inverse = simulation.sensorPose(0).inverse();
   std::vector<Eigen::Isometry3d> poses(frames);
   std::vector<double> stamps(frames);
-  std::atomic<size_t> points{0};
-  tbb::parallel_for(0, frames, [&](int frame) {
-    const SimulatedScan scan = simulation.scan(frame);
-    writeKittiBin(scanPath(velodyne, frame), scan.cloud);
-    points += scan.cloud.size();
-    poses[frame] = simulation.sensorPose(frame);
-    stamps[frame] = simulation.stamp(frame);
-  });
-  const Eigen::Isometry3d first_inverse = poses.front().inverse();
-  for (Eigen::Isometry3d& pose : poses) pose = first_inverse * pose;
-  poses.front().setIdentity();  // exactly, not up to rounding
+  size_t points = 0;
+  // Scans are simulated and written in parallel, then handed on in frame order; a few per thread in
+  // flight keep every core busy without holding the whole sequence in memory.
+  struct Frame {
+    int index;
+    std::shared_ptr<const SimulatedScan> scan;
+  };
+  int next = 0;
+  const size_t in_flight = 2 * static_cast<size_t>(tbb::this_task_arena::max_concurrency());
+  tbb::parallel_pipeline(
+      in_flight,
+      tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
+                                  [&](tbb::flow_control& control) {
+                                    if (next == frames) control.stop();
+                                    return next++;
+                                  }) &
+          tbb::make_filter<int, Frame>(tbb::filter_mode::parallel,
+                                       [&](int frame) {
+                                         auto scan = std::make_shared<const SimulatedScan>(simulation.scan(frame));
+                                         writeKittiBin(scanPath(velodyne, frame), scan->cloud);
+                                         return Frame{frame, std::move(scan)};
+                                       }) &
+          tbb::make_filter<Frame, void>(tbb::filter_mode::serial_in_order, [&](const Frame& frame) {
+            poses[frame.index] = frame.index == 0 ? Eigen::Isometry3d::Identity()  // exactly, not up to rounding
+                                                  : first_inverse * simulation.sensorPose(frame.index);
+            stamps[frame.index] = simulation.stamp(frame.index);
+            points += frame.scan->cloud.size();
+            if (sink) sink(*frame.scan, poses[frame.index]);
+          }));
   writeKittiPoses((root / "poses.txt").string(), poses);
   writeTimes((root / "times.txt").string(), stamps);
   writeKittiCalibration((root / "calib.txt").string(), kittiVeloToCam00());
-  return {frames, points.load()};
+  return {frames, points};
 }
 
 }  // namespace elo::sim

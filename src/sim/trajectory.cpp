@@ -14,6 +14,7 @@ constexpr double kDeceleration = 2.5;         // m/s^2
 constexpr double kArcStep = 0.05;             // m of path between route samples
 constexpr double kCurvatureRamp = 6.0;        // m over which curvature changes, as a clothoid would
 constexpr double kStopDuration = 3.0;         // s standing at each stop of stop-and-go
+constexpr double kLoopMinStraight = 40.0;     // m: the shortest straight of the loop circuit
 
 struct Piece {
   double length;
@@ -32,11 +33,37 @@ struct RoadDesign {
   std::vector<Piece> cycle;
   double stop_spacing = 0.0;  // m between stops; 0: no stops
   bool hills = false;
+  // The cycle is a closed circuit driven at cruise speed from the first frame: every lap retraces the
+  // first exactly, in place and in time.
+  bool closed_circuit = false;
 };
 
+// The turn radius the vehicle takes at cruise speed: tighter in town, wider on the highway.
+double comfortableRadius(double cruise_speed) {
+  return std::max(30.0, cruise_speed * cruise_speed / kLateralAcceleration);
+}
+
+double cycleLength(const RoadDesign& design) {
+  double length = 0.0;
+  for (const Piece& piece : design.cycle) length += piece.length;
+  return length;
+}
+
+// A stadium: two straights and two half turns, starting halfway along a straight so that the seam
+// between laps lies on a straight. The straights make the lap last a whole number of seconds.
+RoadDesign loopDesign(double cruise_speed) {
+  const double radius = comfortableRadius(cruise_speed);
+  const double turns = 2.0 * M_PI * radius;
+  const double straight_length = 0.5 * (loopLapDuration(cruise_speed) * cruise_speed - turns);
+  RoadDesign design;
+  design.cycle = {straight(0.5 * straight_length), turn(180, radius), straight(straight_length), turn(180, radius),
+                  straight(0.5 * straight_length)};
+  design.closed_circuit = true;
+  return design;
+}
+
 RoadDesign designFor(TrajectoryKind kind, double cruise_speed) {
-  // Turns the vehicle can take at cruise speed: tighter in town, wider on the highway.
-  const double radius = std::max(30.0, cruise_speed * cruise_speed / kLateralAcceleration);
+  const double radius = comfortableRadius(cruise_speed);
   switch (kind) {
     case TrajectoryKind::straight:
       return {{straight(1000.0)}};
@@ -55,6 +82,8 @@ RoadDesign designFor(TrajectoryKind kind, double cruise_speed) {
     case TrajectoryKind::uturn:
       // Out, turn back on a tight circle, return beside the outbound leg, turn again: laps of a loop.
       return {{straight(150.0), turn(180, 8.0), straight(150.0), turn(180, 8.0)}};
+    case TrajectoryKind::loop:
+      return loopDesign(cruise_speed);
   }
   throw std::invalid_argument("unknown trajectory kind");
 }
@@ -84,6 +113,17 @@ std::vector<double> curvatureProfile(const RoadDesign& design, double length) {
     eased[i] = (prefix[end] - prefix[begin]) / static_cast<double>(end - begin);
   }
   return eased;
+}
+
+// Scales the curvature so that each lap of a closed circuit turns exactly 360 deg. Sampling every
+// kArcStep rounds each turn to a whole number of samples, which would leave the lap a fraction of a
+// degree open and the laps drifting apart.
+void closeLaps(const RoadDesign& design, std::vector<double>& curvature) {
+  const size_t lap_samples = static_cast<size_t>(std::llround(cycleLength(design) / kArcStep));
+  if (curvature.size() <= lap_samples) return;
+  double lap_turn = 0.0;  // as integratePath sums it
+  for (size_t i = 1; i <= lap_samples; ++i) lap_turn += 0.5 * (curvature[i - 1] + curvature[i]) * kArcStep;
+  for (double& value : curvature) value *= 2.0 * M_PI / lap_turn;
 }
 
 std::vector<Pose2> integratePath(const std::vector<double>& curvature) {
@@ -185,7 +225,8 @@ const std::map<std::string, TrajectoryKind>& trajectoryTable() {
   static const std::map<std::string, TrajectoryKind> table = {
       {"straight", TrajectoryKind::straight}, {"curves", TrajectoryKind::curves},
       {"roundabout", TrajectoryKind::roundabout}, {"hill", TrajectoryKind::hill},
-      {"stop-and-go", TrajectoryKind::stop_and_go}, {"uturn", TrajectoryKind::uturn}};
+      {"stop-and-go", TrajectoryKind::stop_and_go}, {"uturn", TrajectoryKind::uturn},
+      {"loop", TrajectoryKind::loop}};
   return table;
 }
 }  // namespace
@@ -204,16 +245,26 @@ std::string trajectoryName(TrajectoryKind kind) {
 }
 
 std::vector<std::string> trajectoryNames() {
-  return {"straight", "curves", "roundabout", "hill", "stop-and-go", "uturn"};
+  return {"straight", "curves", "roundabout", "hill", "stop-and-go", "uturn", "loop"};
+}
+
+double loopLapDuration(double cruise_speed) {
+  const double shortest_lap = 2.0 * M_PI * comfortableRadius(cruise_speed) + 2.0 * kLoopMinStraight;
+  return std::ceil(shortest_lap / cruise_speed);
 }
 
 Route proceduralRoute(TrajectoryKind kind, double cruise_speed, double duration) {
   const RoadDesign design = designFor(kind, cruise_speed);
   // Never slower than cruise speed, so this much road always lasts the whole drive.
   const double length = cruise_speed * duration + 50.0;
-  const std::vector<double> curvature = curvatureProfile(design, length);
+  std::vector<double> curvature = curvatureProfile(design, length);
+  if (design.closed_circuit) closeLaps(design, curvature);
   const std::vector<Pose2> path = integratePath(curvature);
-  const std::vector<double> speed = speedProfile(curvature, cruise_speed, design.stop_spacing);
+  // The circuit's turns are at the comfortable radius for cruise speed: it is driven at cruise speed all
+  // the way round, from the first frame on.
+  const std::vector<double> speed = design.closed_circuit
+                                        ? std::vector<double>(curvature.size(), cruise_speed)
+                                        : speedProfile(curvature, cruise_speed, design.stop_spacing);
 
   std::vector<double> times{0.0};
   std::vector<Pose2> poses{path[0]};

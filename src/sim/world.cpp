@@ -25,7 +25,8 @@ const std::map<std::string, WorldFamily>& familyTable() {
   static const std::map<std::string, WorldFamily> table = {{"urban", WorldFamily::urban},
                                                            {"highway", WorldFamily::highway},
                                                            {"country", WorldFamily::country},
-                                                           {"parking", WorldFamily::parking}};
+                                                           {"parking", WorldFamily::parking},
+                                                           {"tunnel", WorldFamily::tunnel}};
   return table;
 }
 
@@ -39,6 +40,8 @@ WorldRecipe recipeFor(WorldFamily family) {
       return countryRecipe();
     case WorldFamily::parking:
       return parkingRecipe();
+    case WorldFamily::tunnel:
+      return tunnelRecipe();
   }
   throw std::invalid_argument("unknown world family");
 }
@@ -66,6 +69,9 @@ std::vector<Wave> drawWaves(const std::vector<WaveBand>& bands, uint64_t seed) {
   return waves;
 }
 
+// Road points added before the route's start and after its end to continue it for `length`.
+int extensionPoints(double length) { return static_cast<int>(std::ceil(length / kPathSpacing)); }
+
 // The route's path continued straight for `length` before its start and after its end, so that the
 // street is furnished behind the first scan and ahead of the last as it is everywhere else.
 std::vector<Eigen::Vector2d> roadAlong(const Route& route, double length) {
@@ -73,7 +79,7 @@ std::vector<Eigen::Vector2d> roadAlong(const Route& route, double length) {
   const auto direction = [](const Pose2& pose) { return Eigen::Vector2d(std::cos(pose.heading), std::sin(pose.heading)); };
   const Eigen::Vector2d backward = -direction(route.at(route.startTime()));
   const Eigen::Vector2d forward = direction(route.at(route.endTime()));
-  const int extra = static_cast<int>(std::ceil(length / kPathSpacing));
+  const int extra = extensionPoints(length);
   std::vector<Eigen::Vector2d> road;
   for (int i = extra; i > 0; --i) road.push_back(path.front() + i * kPathSpacing * backward);
   road.insert(road.end(), path.begin(), path.end());
@@ -98,8 +104,9 @@ std::shared_ptr<const HeightField> makeGround(const WorldRecipe& recipe, const R
 }
 
 std::vector<Primitive> furnish(const WorldRecipe& recipe, const Centerline& road, const GroundSurface& ground,
-                               uint64_t seed) {
-  Roadside roadside(road, ground, mixSeed(seed, kRoadsideStream));
+                               const WorldOptions& options) {
+  const double route_start = extensionPoints(options.reach) * kPathSpacing;  // the road's straight lead-in
+  Roadside roadside(road, ground, mixSeed(options.seed, kRoadsideStream), route_start);
   recipe.furnish(roadside);
   return roadside.takePrimitives();
 }
@@ -135,7 +142,7 @@ std::string worldName(WorldFamily family) {
   throw std::invalid_argument("unknown world family");
 }
 
-std::vector<std::string> worldNames() { return {"urban", "highway", "country", "parking"}; }
+std::vector<std::string> worldNames() { return {"urban", "highway", "country", "parking", "tunnel"}; }
 
 double cruiseSpeed(WorldFamily family) { return recipeFor(family).cruise_speed; }
 
@@ -176,7 +183,7 @@ World::World(WorldFamily family, const WorldRecipe& recipe, const Route& route, 
     : family_(family),
       road_(roadAlong(route, options.reach), std::max(recipe.cross_section_reach, recipe.clearance_reach)),
       ground_(makeGround(recipe, route, road_, options)),
-      scene_(ground_, furnish(recipe, road_, *ground_, options.seed), recipe.ground_reflectivity),
+      scene_(ground_, furnish(recipe, road_, *ground_, options), recipe.ground_reflectivity),
       traffic_(road_, *ground_, options.moving_cars, recipe.cruise_speed, mixSeed(options.seed, kTrafficStream)) {}
 
 std::unique_ptr<RayCaster> World::snapshot(double time, const Eigen::Vector3d& position, double radius) const {

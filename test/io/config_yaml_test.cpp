@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sstream>
 
 #include "elo/io/io_error.hpp"
 #include "temp_directory.hpp"
@@ -93,6 +94,23 @@ TEST(ConfigYaml, WrongTypeThrowsNamingTheKey) {
                                      {"ground.max_slope_deg"});
   expectThrowContaining<ConfigError>([&] { loadText(directory, "ground: {max_slope_deg: }\n", config); },
                                      {"ground.max_slope_deg"});
+}
+
+// yaml-cpp throws its own exception for these; the loader names the parameter instead (found by fuzzing).
+TEST(ConfigYaml, MalformedSequenceAndKeyThrowNamingTheParameter) {
+  TempDirectory directory;
+  Config config;
+  expectThrowContaining<ConfigError>([&] { loadText(directory, "sensor: {beam_elevations_deg: [2, 0x]}\n", config); },
+                                     {"sensor.beam_elevations_deg", "sequence of numbers"});
+  expectThrowContaining<ConfigError>([&] { loadText(directory, "sensor: {[image_width]: 5}\n", config); },
+                                     {directory.file("config.yaml") + ":1", "parameter or section name"});
+}
+
+TEST(ConfigYaml, LoadsFromAStream) {
+  std::istringstream stream("ground:\n  max_slope_deg: 4.5\n");
+  Config config;
+  loadConfigYaml(stream, "memory", config);
+  EXPECT_EQ(config.ground.max_slope_deg, 4.5);
 }
 
 TEST(ConfigYaml, UnknownChoiceThrows) {

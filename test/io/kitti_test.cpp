@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <random>
+#include <sstream>
 
 #include "elo/io/io_error.hpp"
 #include "temp_directory.hpp"
@@ -69,6 +70,22 @@ TEST(KittiBin, SizeNotMultipleOf16ThrowsNamingTheFile) {
   const std::string path = directory.file("broken.bin");
   writeText(path, std::string(17, 'x'));
   expectThrowContaining<IoError>([&] { readKittiBin(path); }, {path, "17 bytes", "multiple of 16"});
+}
+
+TEST(KittiBin, ReadsFromAStream) {
+  const std::vector<float> values = {1.0f, 2.0f, 3.0f, 0.5f, -4.0f, 5.0f, 6.0f, 0.25f};
+  std::istringstream stream(std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float)));
+  const PointCloud cloud = readKittiBin(stream, "memory");
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.points[1], Vec3f(-4.0f, 5.0f, 6.0f));
+  EXPECT_EQ(cloud.intensity, (std::vector<float>{0.5f, 0.25f}));
+}
+
+// A directory opens and seeks like a file of 2^63 bytes; it must not size a buffer.
+TEST(KittiBin, DirectoryThrowsNamingIt) {
+  TempDirectory directory;
+  expectThrowContaining<IoError>([&] { readKittiBin(directory.path().string()); },
+                                 {directory.path().string(), "not a regular file"});
 }
 
 TEST(KittiBin, MissingFileThrowsNamingIt) {

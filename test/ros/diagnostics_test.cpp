@@ -55,4 +55,39 @@ TEST(RosDiagnostics, DropsRejectionsAndSkipsWarnAndAreCounted) {
   EXPECT_EQ(valueOf(next, "scans dropped"), "2") << "totals stay";
 }
 
+TEST(RosDiagnostics, RestartsWarnAndAreCountedByReason) {
+  elo_ros::PipelineStatistics statistics;
+  statistics.cloudReceived();
+  statistics.odometryRestarted("gap longer than model.time_window");
+  statistics.scanProcessed(processedScan(60.0), 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  statistics.report(status);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(status.message.find("1 odometry restarts"), std::string::npos) << status.message;
+  EXPECT_EQ(valueOf(status, "odometry restarts: gap longer than model.time_window"), "1");
+}
+
+TEST(RosDiagnostics, DegenerateScansWarnWhileTheyLastAndAreCounted) {
+  elo_ros::PipelineStatistics statistics;
+  elo::FrameResult tunnel = processedScan(60.0);
+  elo::Matrix6d hessian = elo::Vector6d(0, 1, 1, 50, 50, 50).asDiagonal();  // x unconstrained
+  tunnel.registration.degeneracy = *elo::analyseDegeneracy(hessian, 0.005);
+  statistics.cloudReceived();
+  statistics.scanProcessed(tunnel, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper inside;
+  statistics.report(inside);
+  EXPECT_EQ(inside.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(inside.message, "latest scan degenerate along x");
+  EXPECT_EQ(valueOf(inside, "degenerate directions"), "x");
+  EXPECT_EQ(valueOf(inside, "scans degenerate"), "1");
+
+  statistics.cloudReceived();
+  statistics.scanProcessed(processedScan(60.0), 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper outside;
+  statistics.report(outside);
+  EXPECT_EQ(outside.level, diagnostic_msgs::DiagnosticStatus::OK) << outside.message;
+  EXPECT_EQ(valueOf(outside, "degenerate directions"), "none");
+  EXPECT_EQ(valueOf(outside, "scans degenerate"), "1") << "the total stays";
+}
+
 }  // namespace

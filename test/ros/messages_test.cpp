@@ -116,6 +116,20 @@ TEST(RosMessages, CovarianceIsTheScaledInverseHessian) {
   EXPECT_FALSE(elo_ros::registrationCovariance(singular).has_value());
 }
 
+TEST(RosMessages, DegenerateDirectionsGetTheLargeVarianceOfThePrior) {
+  elo::RegistrationResult degenerate = registration(3.0, 2.0);
+  degenerate.hessian(0, 0) = 0.0;  // nothing constrains x: a tunnel
+  degenerate.degeneracy = *elo::analyseDegeneracy(degenerate.hessian, elo::RegistrationConfig().degeneracy_threshold);
+  ASSERT_EQ(degenerate.degeneracy.count, 1);
+  const auto covariance = elo_ros::registrationCovariance(degenerate);
+  ASSERT_TRUE(covariance.has_value()) << "a degenerate scan still has a covariance";
+  EXPECT_NEAR((*covariance)(0, 0), 1.0, 1e-12) << "(1 m)^2 along the degenerate direction";
+  // The constrained directions keep the scaled inverse Hessian, with no correlation to x.
+  const elo::Vector6d constrained = (0.015 / 400.0) * elo::Vector6d(0, 0.5, 0.25, 0.125, 0.0625, 0.03125);
+  EXPECT_LT((covariance->diagonal().tail<5>() - constrained.tail<5>()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT(covariance->row(0).tail<5>().cwiseAbs().maxCoeff(), 1e-15);
+}
+
 elo_ros::FrameBinding frames() {
   const Eigen::Isometry3d base_from_sensor(Eigen::Translation3d(0.8, 0.1, 1.73) *
                                            Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ()));

@@ -1,11 +1,17 @@
-// The elo_sim command line: help, clear errors with exit code 2, and a small run.
+// The elo_sim command line: help, clear errors with exit code 2, and small runs to disk and to a bag.
 #include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 
 #include "../io/temp_directory.hpp"
+#include "elo/io/sequence.hpp"
 
 namespace {
 
@@ -32,7 +38,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --dropout 1.5" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --deskewed yes" + out), 2);
   EXPECT_EQ(runTool("--world urban --poses /nonexistent/poses.txt" + out), 2);
-  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --bag x.bag" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --bag" + out), 2);  // --bag without a file
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2"), 2);               // no output
   EXPECT_FALSE(std::filesystem::exists(directory.file("seq")));
 }
@@ -45,6 +51,50 @@ TEST(EloSimCli, WritesASequence) {
   for (const std::string file : {"velodyne/000000.bin", "velodyne/000002.bin", "poses.txt", "times.txt", "calib.txt"}) {
     EXPECT_TRUE(std::filesystem::exists(directory.file("seq/" + file))) << file;
   }
+}
+
+std::set<std::string> fieldNames(const sensor_msgs::PointCloud2& cloud) {
+  std::set<std::string> names;
+  for (const auto& field : cloud.fields) names.insert(field.name);
+  return names;
+}
+
+// The bag holds the scans written to disk, at their times (+1 s, as kitti_to_bag), with every field a
+// driver publishes for a sweep with motion, and the ground truth of poses.txt.
+TEST(EloSimCli, WritesABag) {
+  const elo::test::TempDirectory directory;
+  const std::string bag_path = directory.file("seq.bag");
+  ASSERT_EQ(runTool("--world urban --trajectory curves --frames 3 --sensor vlp16 --deskewed 0 --output " +
+                    directory.file("seq") + " --bag " + bag_path),
+            0);
+  const elo::Sequence sequence(directory.file("seq"));
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+
+  size_t scan = 0;
+  for (const rosbag::MessageInstance& message : rosbag::View(bag, rosbag::TopicQuery("/points"))) {
+    const auto cloud = message.instantiate<sensor_msgs::PointCloud2>();
+    ASSERT_TRUE(cloud);
+    ASSERT_LT(scan, sequence.size());
+    EXPECT_EQ(cloud->header.frame_id, "velodyne");
+    EXPECT_NEAR(cloud->header.stamp.toSec(), sequence.stamp(scan) + 1.0, 1e-6);
+    EXPECT_EQ(size_t{cloud->width} * cloud->height, sequence.load(scan).size());
+    EXPECT_EQ(fieldNames(*cloud), (std::set<std::string>{"x", "y", "z", "intensity", "ring", "time"}));
+    ++scan;
+  }
+  EXPECT_EQ(scan, 3u);
+
+  size_t pose = 0;
+  for (const rosbag::MessageInstance& message : rosbag::View(bag, rosbag::TopicQuery("/ground_truth"))) {
+    const auto odometry = message.instantiate<nav_msgs::Odometry>();
+    ASSERT_TRUE(odometry);
+    ASSERT_LT(pose, sequence.size());
+    const Eigen::Vector3d expected = sequence.groundTruth()[pose].translation();
+    EXPECT_NEAR(odometry->pose.pose.position.x, expected.x(), 1e-9);
+    EXPECT_NEAR(odometry->pose.pose.position.y, expected.y(), 1e-9);
+    EXPECT_NEAR(odometry->pose.pose.position.z, expected.z(), 1e-9);
+    ++pose;
+  }
+  EXPECT_EQ(pose, 3u);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,15 @@ void writeTumPoses(const std::string& path, const std::vector<double>& stamps,
 Eigen::Isometry3d readKittiCalibration(const std::string& path);
 // Writes P0..P3 as [I|0] and `Tr:`, the layout of the odometry devkit's calib.txt.
 void writeKittiCalibration(const std::string& path, const Eigen::Isometry3d& velo_to_cam);
+
+// The readers above on an open stream, so that data already in memory needs no file; `name` stands for
+// the file in error messages. readKittiBin needs a seekable stream (it checks the size first).
+PointCloud readKittiBin(std::istream& stream, const std::string& name);
+std::vector<double> readTimes(std::istream& stream, const std::string& name);
+std::vector<Eigen::Isometry3d> readKittiPoses(std::istream& stream, const std::string& name);
+std::vector<Eigen::Isometry3d> readTumPoses(std::istream& stream, const std::string& name,
+                                            std::vector<double>* stamps = nullptr);
+Eigen::Isometry3d readKittiCalibration(std::istream& stream, const std::string& name);
 
 // Moves a trajectory between the LiDAR and the camera frame: Tr * P * Tr^-1 and Tr^-1 * P * Tr.
 std::vector<Eigen::Isometry3d> lidarToCamera(const std::vector<Eigen::Isometry3d>& lidar_poses,

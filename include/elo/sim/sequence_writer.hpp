@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 
 #include "elo/sim/simulation.hpp"
@@ -16,8 +17,12 @@ struct SequenceSummary {
   size_t points = 0;
 };
 
-// Frames are simulated in parallel (in the caller's TBB arena). Throws IoError when a file cannot
-// be written.
-SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory);
+// Receives each simulated scan with the sensor's ground-truth pose in the frame of scan 0, in frame
+// order, one call at a time: the scan keeps the fields a KITTI .bin cannot hold (ring, per-point time).
+using ScanSink = std::function<void(const SimulatedScan& scan, const Eigen::Isometry3d& ground_truth)>;
+
+// Frames are simulated in parallel (in the caller's TBB arena), with a bounded number in flight.
+// Throws IoError when a file cannot be written; whatever `sink` throws ends the run.
+SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory, const ScanSink& sink = {});
 
 }  // namespace elo::sim

@@ -45,16 +45,22 @@ class Route {
   std::vector<Hill> hills_;
 };
 
-enum class TrajectoryKind { straight, curves, roundabout, hill, stop_and_go, uturn };
+// `loop` laps a closed circuit at cruise speed from the first frame, each lap the same in place and
+// time: a sequence of exactly one lap replayed end to end is one continuous drive (the soak test).
+enum class TrajectoryKind { straight, curves, roundabout, hill, stop_and_go, uturn, loop };
 
 std::optional<TrajectoryKind> trajectoryKindFromName(const std::string& name);
 std::string trajectoryName(TrajectoryKind kind);
 std::vector<std::string> trajectoryNames();
 
-// A drive of `duration` seconds along the kind's road: from rest up to `cruise_speed` (m/s), slowing
-// for turns to a comfortable lateral acceleration, and stopping for a few seconds every ~150 m in
-// stop-and-go.
+// A drive of `duration` seconds along the kind's road: from rest (the loop: already at speed) up to
+// `cruise_speed` (m/s), slowing for turns to a comfortable lateral acceleration, and stopping for a
+// few seconds every ~150 m in stop-and-go.
 Route proceduralRoute(TrajectoryKind kind, double cruise_speed, double duration);
+
+// Seconds per lap of the `loop` circuit at `cruise_speed`: a whole number, so that a lap is a whole
+// number of frames at any integer frame rate (urban, 10 m/s: 40 s, 400 frames at 10 Hz).
+double loopLapDuration(double cruise_speed);
 
 // A drive through given LiDAR-frame poses, one per frame `frame_period` apart: x, y and heading are
 // theirs; height, pitch and roll come from the ground the route is placed on.

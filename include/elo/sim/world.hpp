@@ -17,7 +17,7 @@
 
 namespace elo::sim {
 
-enum class WorldFamily { urban, highway, country, parking };
+enum class WorldFamily { urban, highway, country, parking, tunnel };
 struct WorldRecipe;
 
 std::optional<WorldFamily> worldFamilyFromName(const std::string& name);

@@ -1,7 +1,10 @@
 // Sec. III-D: the model update. The model lives in the frame of the latest scan: each frame, every model
 // point moves into the new frame and is re-projected; where the scan also has a point the one closer to
 // the sensor stays, where it has none the model's stays, and points older than tau_w go. Only three 2D
-// maps are kept (vertex and normal maps of the SRI, vertex map of the BEV), so memory never grows.
+// maps are kept (vertex and normal maps of the SRI, vertex map of the BEV), so memory never grows. The
+// per-point rules are shared with the CUDA backend (model_update.hpp).
+#include "core/common/eigen_interop.hpp"
+#include "core/common/model_update.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
 
@@ -10,26 +13,22 @@ namespace elo::cpu {
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
                         const Eigen::Isometry3d& model_from_scan, float stamp, float time_window,
                         ClosestWins& winners, SphericalImage& fused) {
-  const Eigen::Isometry3f scan_from_model = model_from_scan.inverse().cast<float>();
-  const Eigen::Matrix3f rotation = scan_from_model.linear();
-  const size_t pixels = model.pixelCount();
-  const auto current = [&](size_t pixel) { return stamp - model.stamp[pixel] <= time_window; };
+  const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
+  const uint32_t pixels = static_cast<uint32_t>(model.pixelCount());
 
-  // Sources 0..pixels-1 are model pixels, pixels..2*pixels-1 scan pixels; each offers itself to the
-  // pixel it projects to and the closest wins.
   winners.reset();
   parallelFor(pixels, [&](size_t pixel) {
-    if (!model.occupied(pixel) || !model.hasNormal(pixel) || !current(pixel)) return;
-    const Vec3f moved = scan_from_model * model.vertex[pixel];
+    if (!model.occupied(pixel) || !model.hasNormal(pixel) || !isCurrent(stamp, model.stamp[pixel], time_window)) return;
+    const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
     int row = 0;
     int col = 0;
     if (!projection.pixelOf(moved, row, col)) return;
-    winners.offer(static_cast<size_t>(row) * projection.cols + col, moved.norm(), static_cast<uint32_t>(pixel));
+    winners.offer(static_cast<size_t>(row) * projection.cols + col, norm(moved), static_cast<uint32_t>(pixel));
   });
   const SphericalImage& observed = scan.image;
   parallelFor(pixels, [&](size_t pixel) {
-    if (scan.label[pixel] != PixelLabel::nonground || !observed.hasNormal(pixel)) return;
-    winners.offer(pixel, observed.range[pixel], static_cast<uint32_t>(pixels + pixel));
+    if (!joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) return;
+    winners.offer(pixel, observed.range[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
   });
 
   parallelFor(pixels, [&](size_t pixel) {
@@ -38,17 +37,18 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
       fused.normal[pixel].setZero();
       return;
     }
-    const size_t source = winners.winner(pixel);
-    if (source >= pixels) {
+    const uint32_t source = winners.winner(pixel);
+    if (isScanSource(source, pixels)) {
       const size_t from = source - pixels;
       fused.vertex[pixel] = observed.vertex[from];
       fused.normal[pixel] = observed.normal[from];
       fused.range[pixel] = observed.range[from];
       fused.stamp[pixel] = observed.stamp[from];
     } else {
-      fused.vertex[pixel] = scan_from_model * model.vertex[source];
-      fused.normal[pixel] = rotation * model.normal[source];
-      fused.range[pixel] = fused.vertex[pixel].norm();
+      const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[source]));
+      fused.vertex[pixel] = toVec3f(moved);
+      fused.normal[pixel] = toVec3f(scan_from_model.rotate(toFloat3(model.normal[source])));
+      fused.range[pixel] = norm(moved);
       fused.stamp[pixel] = model.stamp[source];
     }
   });
@@ -56,15 +56,15 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused) {
-  const Eigen::Isometry3f scan_from_model = model_from_scan.inverse().cast<float>();
+  const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
   fused.clear();
   for (size_t point = 0; point < model.size(); ++point) {
-    if (stamp - model.stamp[point] > time_window) continue;
-    const Vec3f moved = scan_from_model * model.vertex[point];
+    if (!isCurrent(stamp, model.stamp[point], time_window)) continue;
+    const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[point]));
     int row = 0;
     int col = 0;
     if (!projection.cellOf(moved, row, col)) continue;
-    fused.keepCloser(row * projection.cols + col, moved, model.stamp[point]);
+    fused.keepCloser(row * projection.cols + col, toVec3f(moved), model.stamp[point]);
   }
   for (size_t point = 0; point < scan_ground.size(); ++point) {
     fused.keepCloser(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point]);
@@ -75,7 +75,7 @@ void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& 
   const SphericalImage& observed = scan.image;
   SphericalImage& target = model.nonground;
   parallelFor(observed.pixelCount(), [&](size_t pixel) {
-    const bool keep = scan.label[pixel] == PixelLabel::nonground && observed.hasNormal(pixel);
+    const bool keep = joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]));
     target.range[pixel] = keep ? observed.range[pixel] : 0.0f;
     target.vertex[pixel] = observed.vertex[pixel];
     target.normal[pixel] = keep ? observed.normal[pixel] : Vec3f::Zero();

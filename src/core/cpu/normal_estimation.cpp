@@ -2,23 +2,19 @@
 // from the metric extent delta at the point's range (Eq. 12), rejects the point when most neighbours are
 // far from it (sigma_r), fits a plane by eigen-decomposition, drops neighbours far from that plane
 // (sigma_z) and refits; curvature then selects planar points (Eq. 11). The eigen and cross-product
-// estimators are the baselines of Table III.
+// estimators are the baselines of Table III. The window size, the plane fit and the cross-product baseline
+// are shared with the CUDA backend (normals.hpp), which gathers each window with a scalar loop instead.
 #include <algorithm>
 #include <cmath>
 
+#include "core/common/normals.hpp"
+#include "core/cpu/image_views.hpp"
 #include "core/cpu/parallel.hpp"
-#include "core/cpu/plane_fit.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
 
 namespace {
-
-// The odd window size nearest to `pixels`, clamped: odd keeps the window centred on its pixel.
-int oddWindow(double pixels, int smallest, int largest) {
-  const int odd = 2 * static_cast<int>(std::floor(std::max(pixels, 0.0) / 2.0)) + 1;
-  return std::clamp(odd, smallest, largest);
-}
 
 struct Window {
   int half_width;
@@ -32,7 +28,7 @@ struct Window {
 // be done one lane at a time (float addition is not associative), which cost more than the arithmetic.
 class WindowSums {
  public:
-  static constexpr int kLanes = 16;
+  static constexpr int kLanes = kWindowLanes;
 
   WindowSums(const Vec3f& centre, float distant_squared, const Vec3f& plane, float plane_distance)
       : centre_(centre),
@@ -49,11 +45,8 @@ class WindowSums {
 
   PointMoments moments() const {
     PointMoments m;
-    m.sum << total(kSx), total(kSy), total(kSz);
-    const float sxy = total(kSxy);
-    const float sxz = total(kSxz);
-    const float syz = total(kSyz);
-    m.outer << total(kSxx), sxy, sxz, sxy, total(kSyy), syz, sxz, syz, total(kSzz);
+    m.sum = {total(kSx), total(kSy), total(kSz)};
+    m.outer = {total(kSxx), total(kSxy), total(kSxz), total(kSyy), total(kSyz), total(kSzz)};
     m.count = static_cast<int>(total(kCount));
     return m;
   }
@@ -72,22 +65,24 @@ class WindowSums {
       const float dz = z[i] - centre_.z();
       const float present = usable[i] * window[i];
       // Selects, not branches or bool-to-float casts: both become vector blends.
-      const float far = dx * dx + dy * dy + dz * dz > distant_squared_ ? present : 0.0f;
-      const float plane_offset = dx * plane_.x() + dy * plane_.y() + dz * plane_.z();
+      const float far = windowSquaredDistance(dx, dy, dz) > distant_squared_ ? present : 0.0f;
+      const float plane_offset = windowPlaneOffset(dx, dy, dz, plane_.x(), plane_.y(), plane_.z());
       const float on_plane = plane_offset * plane_offset > plane_distance_squared_ ? 0.0f : 1.0f;
-      const float kept = (present - far) * on_plane;
+      const float kept = (present - far) * on_plane;  // 0 or 1: the products with it below are exact
       lanes_[kNeighbours][i] += present;
       lanes_[kDistant][i] += far;
       lanes_[kCount][i] += kept;
       lanes_[kSx][i] += kept * dx;
       lanes_[kSy][i] += kept * dy;
       lanes_[kSz][i] += kept * dz;
-      lanes_[kSxx][i] += kept * dx * dx;
-      lanes_[kSxy][i] += kept * dx * dy;
-      lanes_[kSxz][i] += kept * dx * dz;
-      lanes_[kSyy][i] += kept * dy * dy;
-      lanes_[kSyz][i] += kept * dy * dz;
-      lanes_[kSzz][i] += kept * dz * dz;
+      // The fused multiply-adds GCC would contract these into, written out, so that gatherWindow() of
+      // normals.hpp (the GPU's loop) rounds the same.
+      lanes_[kSxx][i] = fusedMultiplyAdd(kept * dx, dx, lanes_[kSxx][i]);
+      lanes_[kSxy][i] = fusedMultiplyAdd(kept * dx, dy, lanes_[kSxy][i]);
+      lanes_[kSxz][i] = fusedMultiplyAdd(kept * dx, dz, lanes_[kSxz][i]);
+      lanes_[kSyy][i] = fusedMultiplyAdd(kept * dy, dy, lanes_[kSyy][i]);
+      lanes_[kSyz][i] = fusedMultiplyAdd(kept * dy, dz, lanes_[kSyz][i]);
+      lanes_[kSzz][i] = fusedMultiplyAdd(kept * dz, dz, lanes_[kSzz][i]);
     }
   }
 
@@ -144,10 +139,7 @@ void NormalScratch::fill(const ScanImage& scan, int max_window_width) {
 }
 
 WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range) {
-  const double width = config.search_size / (range * M_PI) * projection.cols;
-  const double height = config.search_size / (range * projection.fov_span) * projection.rows;
-  return {oddWindow(width, config.min_window_width, config.max_window_width),
-          oddWindow(height, config.min_window_height, config.max_window_height)};
+  return elo::rangeAdaptiveWindow(NormalParams::fromConfig(config, projection), range);
 }
 
 namespace {
@@ -156,30 +148,35 @@ class NormalEstimator {
  public:
   NormalEstimator(const NormalConfig& config, const SphericalProjection& projection, const NormalScratch& planes,
                   ScanImage& scan)
-      : config_(config), projection_(projection), planes_(planes), scan_(scan), image_(scan.image) {}
+      : config_(config),
+        params_(NormalParams::fromConfig(config, projection)),
+        projection_(projection),
+        planes_(planes),
+        scan_(scan),
+        image_(scan.image) {}
 
   void estimate(size_t pixel) const {
     if (scan_.label[pixel] != PixelLabel::nonground) return;
+    const int row = static_cast<int>(pixel) / projection_.cols;
+    const int col = static_cast<int>(pixel) % projection_.cols;
     if (config_.method == NormalMethod::cross_product) {
-      image_.normal[pixel] = crossProductNormal(pixel);
+      image_.normal[pixel] = toVec3f(crossProductNormal(ScanPixels(scan_), row, col));
       return;
     }
     const bool adaptive = config_.method == NormalMethod::range_adaptive;
     const Window window = windowOf(pixel);
     PointMoments moments;
     if (!gatherNeighbours(pixel, window, adaptive, nullptr, moments)) return;
-    PlaneFit fit = fitEnough(moments);
+    PlaneFit fit = fitEnough(moments, params_);
     if (!fit.valid) return;
-    // Test 2 can only drop a neighbour when sigma_z < sigma_r: |d.n| <= |d|, and test 1 already left out
-    // every neighbour with |d| > sigma_r. With the paper's values (both 0.5 m) the refit is a no-op.
-    if (adaptive && config_.plane_distance < config_.outlier_distance) {
+    if (params_.refit) {
       PointMoments on_plane;
       gatherNeighbours(pixel, window, true, &fit.normal, on_plane);
-      if (on_plane.count != moments.count) fit = fitEnough(on_plane);
+      if (on_plane.count != moments.count) fit = fitEnough(on_plane, params_);
       if (!fit.valid) return;
     }
     if (fit.curvature > config_.max_curvature) return;
-    image_.normal[pixel] = towardsSensor(fit.normal, image_.vertex[pixel]);
+    image_.normal[pixel] = toVec3f(towardsSensor(fit.normal, toFloat3(image_.vertex[pixel])));
   }
 
  private:
@@ -187,30 +184,23 @@ class NormalEstimator {
     if (config_.method == NormalMethod::eigen) {
       return {config_.max_window_width / 2, config_.max_window_height / 2};
     }
-    const WindowSize size = rangeAdaptiveWindow(config_, projection_, image_.range[pixel]);
+    const WindowSize size = elo::rangeAdaptiveWindow(params_, image_.range[pixel]);
     return {size.width / 2, size.height / 2};
-  }
-
-  bool usable(int row, int col) const {
-    return row >= 0 && row < projection_.rows && scan_.label[index(row, col)] == PixelLabel::nonground;
-  }
-  size_t index(int row, int col) const {
-    const int wrapped = (col % projection_.cols + projection_.cols) % projection_.cols;  // azimuth is circular
-    return static_cast<size_t>(row) * projection_.cols + wrapped;
   }
 
   // Accumulates the window's non-ground pixels (the centre included) as offsets from the centre. With
   // `reject_distant`, test 1 of the paper: neighbours farther than sigma_r are left out, and when they
   // are more than half of all the centre is an outlier and gets no normal (returns false). With a
   // `plane` normal, test 2: neighbours farther than sigma_z from the plane through the centre are left out.
-  bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, const Vec3f* plane,
+  bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, const Float3* plane,
                         PointMoments& moments) const {
     const int cols = projection_.cols;
     const int row = static_cast<int>(pixel) / cols;
     const int col = static_cast<int>(pixel) % cols;
     WindowSums sums(image_.vertex[pixel],
                     reject_distant ? static_cast<float>(config_.outlier_distance * config_.outlier_distance) : INFINITY,
-                    plane ? *plane : Vec3f::Zero(), plane ? static_cast<float>(config_.plane_distance) : INFINITY);
+                    plane ? toVec3f(*plane) : Vec3f::Zero(),
+                    plane ? static_cast<float>(config_.plane_distance) : INFINITY);
     const float* mask = planes_.window_mask.data() + static_cast<size_t>(window.half_width) * planes_.span;
     for (int r = std::max(0, row - window.half_height); r <= std::min(projection_.rows - 1, row + window.half_height);
          ++r) {
@@ -220,40 +210,8 @@ class NormalEstimator {
     return 2 * sums.distant() <= sums.neighbours() - 1;  // the centre is not its own neighbour
   }
 
-  PlaneFit fitEnough(const PointMoments& moments) const {
-    if (moments.count < config_.min_neighbours) return {};
-    return fitPlane(moments);
-  }
-
-  // The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away.
-  const Vec3f* nearestAlong(int row, int col, int row_step, int col_step) const {
-    for (int step = 1; step <= 2; ++step) {
-      const int r = row + step * row_step;
-      const int c = col + step * col_step;
-      if (usable(r, c)) return &image_.vertex[index(r, c)];
-    }
-    return nullptr;
-  }
-
-  Vec3f crossProductNormal(size_t pixel) const {
-    const int row = static_cast<int>(pixel) / projection_.cols;
-    const int col = static_cast<int>(pixel) % projection_.cols;
-    const Vec3f* left = nearestAlong(row, col, 0, -1);
-    const Vec3f* right = nearestAlong(row, col, 0, 1);
-    const Vec3f* up = nearestAlong(row, col, -1, 0);
-    const Vec3f* down = nearestAlong(row, col, 1, 0);
-    if (!left || !right || !up || !down) return Vec3f::Zero();
-    const Vec3f normal = (*right - *left).cross(*down - *up);
-    const float length = normal.norm();
-    if (!(length > 0.0f)) return Vec3f::Zero();
-    return towardsSensor(normal / length, image_.vertex[pixel]);
-  }
-
-  static Vec3f towardsSensor(const Vec3f& normal, const Vec3f& point) {
-    return normal.dot(point) > 0.0f ? Vec3f(-normal) : normal;
-  }
-
   const NormalConfig& config_;
+  const NormalParams params_;
   const SphericalProjection& projection_;
   const NormalScratch& planes_;
   ScanImage& scan_;

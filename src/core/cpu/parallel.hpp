@@ -8,7 +8,51 @@
 #include <cstddef>
 #include <vector>
 
+#if defined(__SANITIZE_THREAD__)
+#define ELO_THREAD_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define ELO_THREAD_SANITIZER 1
+#endif
+#endif
+#ifdef ELO_THREAD_SANITIZER
+#include <sanitizer/tsan_interface.h>
+#endif
+
 namespace elo::cpu {
+
+// TBB starts and joins its tasks inside libtbb, which ThreadSanitizer cannot see (Debian's TBB is not
+// instrumented), so a TSan build would report every value a task writes and the caller reads after the
+// loop. These annotations state what tbb::parallel_for guarantees and no more: what the caller did
+// before the loop happens before every task, and every task happens before the loop returns. Tasks
+// gain no order among themselves, so a race between two tasks is still reported. No-ops otherwise.
+class ForkJoinOrder {
+ public:
+#ifdef ELO_THREAD_SANITIZER
+  // `task` is what the loop hands its threads. Its address escapes only at the loop, so the compiler
+  // may still be storing into it after the release; the empty asm that takes its address forbids that.
+  template <typename Task>
+  void beforeLoop(const Task& task) {
+    asm volatile("" : : "g"(&task) : "memory");
+    __tsan_release(&fork_token_);
+  }
+  // Static, so that a task acquires before it reads anything of the loop, even its captures. The one
+  // token also orders tasks after other threads' loop starts; only callers on several threads notice.
+  static void taskStarts() { __tsan_acquire(&fork_token_); }
+  void taskEnds() { __tsan_release(&join_); }
+  void afterLoop() { __tsan_acquire(&join_); }
+
+ private:
+  inline static char fork_token_ = 0;
+  char join_ = 0;
+#else
+  template <typename Task>
+  void beforeLoop(const Task&) {}
+  static void taskStarts() {}
+  void taskEnds() {}
+  void afterLoop() {}
+#endif
+};
 
 // Sums `body(begin, end, partial)` over [0, count) in fixed blocks and adds the block results in block
 // order. The result is therefore the same bit for bit whatever the number of threads, so trajectories
@@ -18,9 +62,15 @@ Sum deterministicSum(size_t count, const Body& body) {
   constexpr size_t kBlock = 4096;
   const size_t blocks = (count + kBlock - 1) / kBlock;
   std::vector<Sum> partials(blocks);
-  tbb::parallel_for(size_t{0}, blocks, [&](size_t block) {
+  ForkJoinOrder order;
+  const auto sum_block = [&](size_t block) {
+    ForkJoinOrder::taskStarts();
     body(block * kBlock, std::min(count, (block + 1) * kBlock), partials[block]);
-  });
+    order.taskEnds();
+  };
+  order.beforeLoop(sum_block);
+  tbb::parallel_for(size_t{0}, blocks, sum_block);
+  order.afterLoop();
   Sum total;
   for (const Sum& partial : partials) total += partial;
   return total;
@@ -29,9 +79,15 @@ Sum deterministicSum(size_t count, const Body& body) {
 // Runs `body(i)` for every i in [0, count) across the threads of the current arena.
 template <typename Body>
 void parallelFor(size_t count, const Body& body) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1024), [&](const tbb::blocked_range<size_t>& range) {
+  ForkJoinOrder order;
+  const auto run_range = [&](const tbb::blocked_range<size_t>& range) {
+    ForkJoinOrder::taskStarts();
     for (size_t i = range.begin(); i != range.end(); ++i) body(i);
-  });
+    order.taskEnds();
+  };
+  order.beforeLoop(run_range);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1024), run_range);
+  order.afterLoop();
 }
 
 }  // namespace elo::cpu

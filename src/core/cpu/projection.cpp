@@ -1,47 +1,26 @@
-// Sec. III-B.1: spherical projection of the scan into an index range image, closest point per pixel.
-#include <cmath>
-
+// Sec. III-B.1: spherical projection of the scan into an index range image, closest point per pixel. The
+// per-point math is shared with the CUDA backend (scan_projection.hpp).
+#include "core/common/eigen_interop.hpp"
+#include "core/common/scan_projection.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
 
-namespace {
-
-struct ElevationCorrection {
-  bool active = false;
-  float cos_angle = 1.0f;
-  float sin_angle = 0.0f;
-
-  explicit ElevationCorrection(double degrees)
-      : active(degrees != 0.0),
-        cos_angle(static_cast<float>(std::cos(degrees * M_PI / 180.0))),
-        sin_angle(static_cast<float>(std::sin(degrees * M_PI / 180.0))) {}
-
-  Vec3f apply(const Vec3f& p) const { return active ? correctElevation(p, cos_angle, sin_angle) : p; }
-};
-
-}  // namespace
-
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan) {
-  const ElevationCorrection correction(sensor.elevation_correction_deg);
+  const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
   const bool use_ring = !ring_rows.empty() && cloud.ring.size() == cloud.points.size();
   winners.reset();
   parallelFor(cloud.points.size(), [&](size_t i) {
-    if (!cloud.points[i].allFinite()) return;
-    const Vec3f p = correction.apply(cloud.points[i]);
-    int row = 0;
-    int col = 0;
-    if (!projection.pixelOf(p, row, col)) return;
-    if (use_ring) {
-      // The driver knows the beam: its row is exact where the elevation of a noisy point is not.
-      const uint16_t ring = cloud.ring[i];
-      if (ring >= ring_rows.size()) return;
-      row = ring_rows[ring];
-      if (row < 0 || row >= projection.rows) return;
+    Float3 corrected;
+    int pixel = 0;
+    const int ring = use_ring ? cloud.ring[i] : kNoRing;
+    if (!scanPointPixel(projection, correction, toFloat3(cloud.points[i]), ring, ring_rows.data(),
+                        static_cast<int>(ring_rows.size()), corrected, pixel)) {
+      return;
     }
-    winners.offer(static_cast<size_t>(row) * projection.cols + col, p.norm(), static_cast<uint32_t>(i));
+    winners.offer(pixel, norm(corrected), static_cast<uint32_t>(i));
   });
 
   SphericalImage& image = scan.image;
@@ -55,9 +34,9 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
       return;
     }
     const uint32_t index = winners.winner(pixel);
-    const Vec3f p = correction.apply(cloud.points[index]);
-    image.vertex[pixel] = p;
-    image.range[pixel] = p.norm();
+    const Float3 p = correction.apply(toFloat3(cloud.points[index]));
+    image.vertex[pixel] = toVec3f(p);
+    image.range[pixel] = norm(p);
     image.stamp[pixel] = stamp;
     scan.point_index[pixel] = static_cast<int32_t>(index);
     scan.label[pixel] = PixelLabel::nonground;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/common/normals.hpp"
 #include "core/cpu/closest_wins.hpp"
 #include "elo/backend.hpp"
 #include "elo/sensor_model.hpp"
@@ -23,10 +24,7 @@ void segmentGround(const GroundConfig& config, ScanImage& scan);
 void labelAllNonground(ScanImage& scan);
 
 // normal_estimation.cpp: normals of the non-ground pixels by the configured method.
-struct WindowSize {
-  int width;   // l_x, pixels, odd
-  int height;  // l_y, pixels, odd
-};
+using elo::WindowSize;
 // The range-adaptive window of Eq. 12 for a point at `range`.
 WindowSize rangeAdaptiveWindow(const NormalConfig& config, const SphericalProjection& projection, float range);
 // The non-ground image as separate coordinate planes and a 0/1 mask, so that the window loops of the
@@ -52,8 +50,9 @@ void estimateNormals(const NormalConfig& config, const SphericalProjection& proj
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground);
 
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
-// (Sec. III-C.2) and kept until the model changes. Safe to query from many threads: a cell is fitted
-// from the model alone, so whichever thread fits it first stores the same value any other would.
+// (Sec. III-C.2, groundNormal() of association.hpp) and kept until the model changes. Safe to query from
+// many threads: a cell is fitted from the model alone, so whichever thread fits it first stores the same
+// value any other would.
 class GroundNormalCache {
  public:
   // Forgets every normal; call whenever the model changes, with its new point count.
@@ -85,10 +84,6 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
                         ClosestWins& winners, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused);
-// The point of `map` nearest to `point` in the cell of (row, col), or else in the first ring of cells
-// around it that holds any, up to `radius` rings out; -1 when there is none.
-int32_t nearestGroundPoint(const BevImage& map, const BevProjection& projection, const Vec3f& point, int row, int col,
-                           int radius);
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
 

@@ -37,6 +37,7 @@ WorldRecipe urbanRecipe();
 WorldRecipe highwayRecipe();
 WorldRecipe countryRecipe();
 WorldRecipe parkingRecipe();
+WorldRecipe tunnelRecipe();
 
 // Smooth step from 0 at `begin` to 1 at `end` (zero slope at both ends).
 inline double smoothStep(double begin, double end, double x) {

@@ -55,8 +55,8 @@ std::vector<Eigen::Vector2d> rectangle(const Eigen::Vector2d& center, double hea
 
 }  // namespace
 
-Roadside::Roadside(const Centerline& road, const GroundSurface& ground, uint64_t seed)
-    : road_(road), ground_(ground), seed_(seed) {}
+Roadside::Roadside(const Centerline& road, const GroundSurface& ground, uint64_t seed, double route_start)
+    : road_(road), ground_(ground), seed_(seed), route_start_(route_start) {}
 
 void Roadside::forEachLot(double frontage, const std::function<double(Rng&)>& lot_length,
                           const std::function<void(const Lot&, Rng&)>& furnish) {

@@ -36,7 +36,10 @@ class Roadside {
     double depth = 1.0;
   };
 
-  Roadside(const Centerline& road, const GroundSurface& ground, uint64_t seed);
+  // `route_start`: the arc length along `road` where the driven route begins (the road runs on behind it).
+  Roadside(const Centerline& road, const GroundSurface& ground, uint64_t seed, double route_start);
+
+  double routeStart() const { return route_start_; }
 
   // Calls furnish(lot, rng) for consecutive lots along each side of the route, their lengths drawn
   // by lot_length. A lot is skipped where its frontage (the line `frontage` metres out) runs where a
@@ -73,6 +76,7 @@ class Roadside {
   const Centerline& road_;
   const GroundSurface& ground_;
   uint64_t seed_;
+  double route_start_;
   int pass_ = 0;  // forEachLot calls so far: each draws its own random streams
   std::vector<Primitive> primitives_;
 };

@@ -1,0 +1,57 @@
+// Degeneracy of a registration (Zhang, Kaess & Singh, "On Degeneracy of Optimization-based State
+// Estimation Problems", ICRA 2016): the directions of motion a scan does not constrain (along a long
+// tunnel, along a featureless motorway), read from the eigen-decomposition of the Gauss-Newton Hessian,
+// and the step that solves only the constrained directions, so that the degenerate ones stay where the
+// motion prior put them (solution remapping).
+//
+// The raw Hessian mixes units: the translation rows of the Jacobian are the normal n (dimensionless), the
+// rotation rows p x n carry the point's lever arm (m). Its eigenvalues compare m^0 with m^2, and a
+// threshold on them would depend on how far away the walls are. So the analysis scales the rotation part
+// by the RMS lever arm of the correspondences, L = sqrt(tr H_rr / tr H_tt), and divides by tr H_tt: both
+// diagonal blocks then have trace 1, and an eigenvalue is the share of the constraint along its direction.
+// For a pure translation d it is the mean of (n . d)^2 over the correspondences (weighted as H is); for a
+// pure rotation about a, the share of their squared moments about a. An isotropic scene gives 1/3 for each
+// of the six; the eigenvalues sum to 2. In a straight tunnel the forward translation gets only what
+// normal noise leaves (measured in the README, Degeneracy). The full 6x6 is decomposed, not the two blocks
+// apart, because in a curving tunnel the unobservable motion is a screw (forward translation with yaw)
+// that neither block shows alone.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "elo/se3.hpp"
+
+namespace elo {
+
+struct Degeneracy {
+  Vector6d eigenvalues = Vector6d::Zero();       // of the scaled Hessian, ascending
+  Matrix6d eigenvectors = Matrix6d::Identity();  // matching unit columns, in scaled twist coordinates
+  double lever_arm = 1.0;                        // L (m): the RMS lever arm of the correspondences
+  int count = 0;  // eigenvalues under the threshold: the first `count` eigenvectors are degenerate
+
+  bool any() const { return count > 0; }
+  // Keeps the degenerate components of a twist (translation m, rotation rad) and drops the constrained
+  // ones, orthogonally in scaled coordinates (translation m, rotation times L: the arc it sweeps at L).
+  Matrix6d degenerateProjector() const;
+  // The covariance of the estimated twist: `measurement_scale` * `hessian`^-1 within the constrained
+  // directions (the residual variance over the inlier count), and `prior_variance` (m^2 in scaled
+  // coordinates) along each degenerate one, where the estimate is the prior's.
+  Matrix6d covariance(const Matrix6d& hessian, double measurement_scale, double prior_variance) const;
+  // The sensor-frame axes each degenerate direction is made of, e.g. "x" along a straight tunnel or
+  // "x+yaw" along a curving one; directions separated by "; ", empty when there is none.
+  std::string describe() const;
+};
+
+// Decomposes the fused Hessian and counts the eigenvalues under `threshold` (0: none is degenerate).
+// Nullopt when H constrains no translation or no rotation at all.
+std::optional<Degeneracy> analyseDegeneracy(const Matrix6d& hessian, double threshold);
+
+// The Gauss-Newton step that minimises the linearised cost H, g within the constrained directions of
+// `degeneracy` (which may come from another Hessian than `hessian`): zero along the degenerate ones.
+// With none degenerate it is -H^-1 g. Nullopt when H is not positive definite within the constrained
+// directions.
+std::optional<Vector6d> constrainedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
+                                        const Vector6d& gradient);
+
+}  // namespace elo

@@ -1,0 +1,228 @@
+// Sec. III-B.3-4, Eq. 10-12: the normal of one pixel of the non-ground range image, by the range-adaptive
+// estimator or the Table III baselines. The CUDA backend runs pixelNormal() once per pixel. The CPU
+// backend gathers the windows with vectorised masked sums instead (normal_estimation.cpp) and shares the
+// rest; gatherWindow() adds in the order and with the roundings of those sums, so both backends get the
+// same normals bit for bit, which a CPU test checks.
+//
+// An Image provides `rows`, `cols`, `bool usable(int pixel)` (a non-ground pixel), `Float3 vertex(int
+// pixel)` and `float range(int pixel)`.
+#pragma once
+
+#include <cmath>
+
+#include "core/common/plane_fit.hpp"
+#include "elo/config.hpp"
+#include "elo/projections.hpp"
+
+namespace elo {
+
+// The CPU backend sums a window row in vectors of this many lanes.
+constexpr int kWindowLanes = 16;
+
+struct NormalParams {
+  NormalMethod method;
+  int rows;
+  int cols;
+  float fov_span;
+  double search_size;  // delta
+  int min_window_width;
+  int max_window_width;
+  int min_window_height;
+  int max_window_height;
+  int window_span;                 // lanes of a window row in the CPU's sums: the widest window, rounded up to 16
+  float outlier_distance_squared;  // sigma_r^2
+  float plane_distance;            // sigma_z
+  // Test 2 can only drop a neighbour when sigma_z < sigma_r: |d.n| <= |d|, and test 1 already left out
+  // every neighbour with |d| > sigma_r. With the paper's values (both 0.5 m) the refit is a no-op.
+  bool refit;
+  int min_neighbours;
+  double max_curvature;
+
+  static NormalParams fromConfig(const NormalConfig& config, const SphericalProjection& projection) {
+    return {config.method,
+            projection.rows,
+            projection.cols,
+            projection.fov_span,
+            config.search_size,
+            config.min_window_width,
+            config.max_window_width,
+            config.min_window_height,
+            config.max_window_height,
+            kWindowLanes * ((config.max_window_width + kWindowLanes - 1) / kWindowLanes),
+            static_cast<float>(config.outlier_distance * config.outlier_distance),
+            static_cast<float>(config.plane_distance),
+            config.method == NormalMethod::range_adaptive && config.plane_distance < config.outlier_distance,
+            config.min_neighbours,
+            config.max_curvature};
+  }
+};
+
+struct WindowSize {
+  int width;   // l_x, pixels, odd
+  int height;  // l_y, pixels, odd
+};
+
+// The odd window size nearest to `pixels`, clamped: odd keeps the window centred on its pixel.
+ELO_HOST_DEVICE inline int oddWindow(double pixels, int smallest, int largest) {
+  const double positive = pixels < 0.0 ? 0.0 : pixels;
+  const int odd = 2 * static_cast<int>(std::floor(positive / 2.0)) + 1;
+  return odd < smallest ? smallest : (largest < odd ? largest : odd);
+}
+
+// The range-adaptive window of Eq. 12 for a point at `range`.
+ELO_HOST_DEVICE inline WindowSize rangeAdaptiveWindow(const NormalParams& params, float range) {
+  const double width = params.search_size / (range * M_PI) * params.cols;
+  const double height = params.search_size / (range * params.fov_span) * params.rows;
+  return {oddWindow(width, params.min_window_width, params.max_window_width),
+          oddWindow(height, params.min_window_height, params.max_window_height)};
+}
+
+ELO_HOST_DEVICE inline Float3 towardsSensor(const Float3& normal, const Float3& point) {
+  return dot(normal, point) > 0.0f ? -normal : normal;
+}
+
+ELO_HOST_DEVICE inline int wrapColumn(int col, int cols) { return (col % cols + cols) % cols; }  // azimuth is circular
+
+// The arithmetic of one neighbour at offset (dx, dy, dz) from the window's centre, which the CPU
+// backend's vectorised lanes and gatherWindow() both call.
+ELO_HOST_DEVICE inline float windowSquaredDistance(float dx, float dy, float dz) {
+  return fusedMultiplyAdd(dz, dz, fusedMultiplyAdd(dy, dy, dx * dx));
+}
+ELO_HOST_DEVICE inline float windowPlaneOffset(float dx, float dy, float dz, float nx, float ny, float nz) {
+  return fusedMultiplyAdd(dz, nz, fusedMultiplyAdd(dy, ny, dx * nx));
+}
+
+// Accumulates the window's non-ground pixels (the centre included) as offsets from the centre. With
+// `reject_distant`, test 1 of the paper: neighbours farther than sigma_r are left out, and when they are
+// more than half of all the centre is an outlier and gets no normal (returns false). With a `plane`
+// normal, test 2: neighbours farther than sigma_z from the plane through the centre are left out.
+//
+// The sums are formed as the CPU backend forms them: lane L of a window row holds the column offsets
+// L - span/2 (+ 16, + 32 ... for wider windows), each lane sums over the rows from the top, and the 16
+// lanes are then added pairwise (lane i += lane i + 8, + 4, + 2, + 1). Lanes outside the window add only
+// zeros there, which change no sum, so they are skipped here.
+template <typename Image>
+ELO_HOST_DEVICE bool gatherWindow(const Image& image, int row, int col, int half_width, int half_height,
+                                  bool reject_distant, const Float3* plane, const NormalParams& params,
+                                  PointMoments& moments) {
+  enum { kSx, kSy, kSz, kSxx, kSxy, kSxz, kSyy, kSyz, kSzz, kSums };
+  const Float3 centre = image.vertex(row * image.cols + col);
+  const float plane_distance_squared = params.plane_distance * params.plane_distance;
+  const int first_row = row - half_height < 0 ? 0 : row - half_height;
+  const int last_row = row + half_height > image.rows - 1 ? image.rows - 1 : row + half_height;
+  const int pad = params.window_span / 2;
+  float lanes[kWindowLanes][kSums] = {};
+  int neighbours = 0;
+  int distant = 0;
+  int kept = 0;
+  for (int lane = 0; lane < kWindowLanes; ++lane) {
+    float sums[kSums] = {};  // the lane's sums, kept in registers on the GPU while they grow
+    for (int r = first_row; r <= last_row; ++r) {
+      for (int segment = 0; segment < params.window_span; segment += kWindowLanes) {
+        const int offset = segment + lane - pad;
+        if (offset < -half_width || offset > half_width) continue;
+        const int pixel = r * image.cols + wrapColumn(col + offset, image.cols);
+        if (!image.usable(pixel)) continue;
+        const Float3 vertex = image.vertex(pixel);
+        const float dx = vertex.x - centre.x;
+        const float dy = vertex.y - centre.y;
+        const float dz = vertex.z - centre.z;
+        ++neighbours;
+        if (reject_distant && windowSquaredDistance(dx, dy, dz) > params.outlier_distance_squared) {
+          ++distant;
+          continue;
+        }
+        if (plane != nullptr) {
+          const float plane_offset = windowPlaneOffset(dx, dy, dz, plane->x, plane->y, plane->z);
+          if (plane_offset * plane_offset > plane_distance_squared) continue;
+        }
+        ++kept;
+        sums[kSx] += dx;
+        sums[kSy] += dy;
+        sums[kSz] += dz;
+        sums[kSxx] = fusedMultiplyAdd(dx, dx, sums[kSxx]);
+        sums[kSxy] = fusedMultiplyAdd(dx, dy, sums[kSxy]);
+        sums[kSxz] = fusedMultiplyAdd(dx, dz, sums[kSxz]);
+        sums[kSyy] = fusedMultiplyAdd(dy, dy, sums[kSyy]);
+        sums[kSyz] = fusedMultiplyAdd(dy, dz, sums[kSyz]);
+        sums[kSzz] = fusedMultiplyAdd(dz, dz, sums[kSzz]);
+      }
+    }
+    for (int q = 0; q < kSums; ++q) lanes[lane][q] = sums[q];
+  }
+  for (int width = kWindowLanes / 2; width > 0; width /= 2) {
+    for (int i = 0; i < width; ++i) {
+      for (int q = 0; q < kSums; ++q) lanes[i][q] += lanes[i + width][q];
+    }
+  }
+  moments.sum = {lanes[0][kSx], lanes[0][kSy], lanes[0][kSz]};
+  moments.outer = {lanes[0][kSxx], lanes[0][kSxy], lanes[0][kSxz], lanes[0][kSyy], lanes[0][kSyz], lanes[0][kSzz]};
+  moments.count = kept;
+  return 2 * distant <= neighbours - 1;  // the centre is not its own neighbour
+}
+
+ELO_HOST_DEVICE inline PlaneFit fitEnough(const PointMoments& moments, const NormalParams& params) {
+  if (moments.count < params.min_neighbours) return {};
+  return fitPlane(moments);
+}
+
+// The eigen (fixed largest window, no outlier tests) or range-adaptive normal of the pixel at (row,
+// col), which must be non-ground; zero when it has none.
+template <typename Image>
+ELO_HOST_DEVICE Float3 windowNormal(const Image& image, int row, int col, const NormalParams& params) {
+  const Float3 none{0.0f, 0.0f, 0.0f};
+  const int pixel = row * image.cols + col;
+  const bool adaptive = params.method == NormalMethod::range_adaptive;
+  const WindowSize size = adaptive ? rangeAdaptiveWindow(params, image.range(pixel))
+                                   : WindowSize{params.max_window_width, params.max_window_height};
+  PointMoments moments;
+  if (!gatherWindow(image, row, col, size.width / 2, size.height / 2, adaptive, nullptr, params, moments)) return none;
+  PlaneFit fit = fitEnough(moments, params);
+  if (!fit.valid) return none;
+  if (params.refit) {
+    PointMoments on_plane;
+    gatherWindow(image, row, col, size.width / 2, size.height / 2, true, &fit.normal, params, on_plane);
+    if (on_plane.count != moments.count) fit = fitEnough(on_plane, params);
+    if (!fit.valid) return none;
+  }
+  if (fit.curvature > params.max_curvature) return none;
+  return towardsSensor(fit.normal, image.vertex(pixel));
+}
+
+// The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away; -1
+// when there is none.
+template <typename Image>
+ELO_HOST_DEVICE int nearestAlong(const Image& image, int row, int col, int row_step, int col_step) {
+  for (int step = 1; step <= 2; ++step) {
+    const int r = row + step * row_step;
+    if (r < 0 || r >= image.rows) continue;
+    const int pixel = r * image.cols + wrapColumn(col + step * col_step, image.cols);
+    if (image.usable(pixel)) return pixel;
+  }
+  return -1;
+}
+
+// The cross-product baseline of Table III: the cross product of the horizontal and vertical image
+// gradients at (row, col); zero when a neighbour is missing.
+template <typename Image>
+ELO_HOST_DEVICE Float3 crossProductNormal(const Image& image, int row, int col) {
+  const Float3 none{0.0f, 0.0f, 0.0f};
+  const int left = nearestAlong(image, row, col, 0, -1);
+  const int right = nearestAlong(image, row, col, 0, 1);
+  const int up = nearestAlong(image, row, col, -1, 0);
+  const int down = nearestAlong(image, row, col, 1, 0);
+  if (left < 0 || right < 0 || up < 0 || down < 0) return none;
+  const Float3 normal = cross(image.vertex(right) - image.vertex(left), image.vertex(down) - image.vertex(up));
+  const float length = norm(normal);
+  if (!(length > 0.0f)) return none;
+  return towardsSensor(normal / length, image.vertex(row * image.cols + col));
+}
+
+// The normal of a non-ground pixel by the configured method.
+template <typename Image>
+ELO_HOST_DEVICE Float3 pixelNormal(const Image& image, int row, int col, const NormalParams& params) {
+  return params.method == NormalMethod::cross_product ? crossProductNormal(image, row, col)
+                                                      : windowNormal(image, row, col, params);
+}
+
+}  // namespace elo

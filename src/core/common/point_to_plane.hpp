@@ -1,0 +1,31 @@
+// The point-to-plane term of one correspondence (Eq. 6-9, 15-17). With the left update T <- exp(delta) T
+// and p' = T u, the residual e = n^T (p' - v) has the Jacobian J = [n^T, (p' x n)^T] (PAPER_NOTES: the
+// moved scan point, not the model vertex). Residuals are weighted by a Geman-McClure kernel (IRLS).
+#pragma once
+
+#include "elo/device_types.hpp"
+
+namespace elo {
+
+struct PointToPlane {
+  double residual;
+  double weight;
+  double jacobian[6];
+};
+
+// Geman-McClure IRLS weight; a scale of 0 weighs all residuals equally.
+ELO_HOST_DEVICE inline double gemanMcClureWeight(double residual, double scale) {
+  if (scale <= 0.0) return 1.0;
+  const double s2 = scale * scale;
+  const double denominator = s2 + residual * residual;
+  return s2 * s2 / (denominator * denominator);
+}
+
+ELO_HOST_DEVICE inline PointToPlane pointToPlane(const Float3& moved, const Float3& model_vertex, const Float3& normal,
+                                                 double kernel_scale) {
+  const double residual = dot(normal, moved - model_vertex);
+  const Float3 moment = cross(moved, normal);
+  return {residual, gemanMcClureWeight(residual, kernel_scale), {normal.x, normal.y, normal.z, moment.x, moment.y, moment.z}};
+}
+
+}  // namespace elo

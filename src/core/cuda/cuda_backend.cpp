@@ -1,0 +1,356 @@
+#include "core/cuda/cuda_backend.hpp"
+
+#include <chrono>
+#include <cstring>
+
+#include "core/common/eigen_interop.hpp"
+#include "elo/sensor_model.hpp"
+
+namespace elo::cuda {
+
+namespace {
+
+// Host and device arrays of points copy byte for byte.
+static_assert(sizeof(Vec3f) == sizeof(Float3), "Eigen::Vector3f and Float3 must both be three packed floats");
+static_assert(sizeof(PixelLabel) == 1, "labels copy byte for byte");
+
+using Clock = std::chrono::steady_clock;
+
+template <typename T>
+void clear(const DeviceArray<T>& array, size_t count, int byte, cudaStream_t stream) {
+  check(cudaMemsetAsync(array.data(), byte, count * sizeof(T), stream), "cudaMemsetAsync");
+}
+
+template <typename Host, typename Device>
+void copyToHost(std::vector<Host>& host, const Device* device, size_t count, cudaStream_t stream) {
+  static_assert(sizeof(Host) == sizeof(Device), "host and device elements differ in size");
+  if (count == 0) return;
+  check(cudaMemcpyAsync(host.data(), device, count * sizeof(Device), cudaMemcpyDeviceToHost, stream),
+        "copying a buffer to the host");
+}
+
+// JtJ comes as its upper triangle, row by row.
+TermSums toTermSums(const DeviceTermSums& device) {
+  TermSums sums;
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i; j < 6; ++j) sums.JtJ(i, j) = sums.JtJ(j, i) = device.values[k++];
+  }
+  for (int i = 0; i < 6; ++i) sums.Jte(i) = device.values[kJtJValues + i];
+  sums.squared_error = device.values[kTermValues - 1];
+  sums.candidates = device.candidates;
+  sums.inliers = device.inliers;
+  return sums;
+}
+
+}  // namespace
+
+void CudaBackend::SphericalBuffers::allocate(size_t pixels) {
+  vertices.reserve(pixels);
+  normals.reserve(pixels);
+  ranges.reserve(pixels);
+  stamps.reserve(pixels);
+}
+
+void CudaBackend::BevBuffers::allocate(size_t grid_cells, size_t points) {
+  point_of_cell.reserve(grid_cells);
+  cells.reserve(points);
+  vertices.reserve(points);
+  ranges.reserve(points);
+  stamps.reserve(points);
+}
+
+CudaBackend::CudaBackend(const Config& config)
+    : config_(config),
+      spherical_(SphericalProjection::fromConfig(config.sensor)),
+      bev_(BevProjection::fromConfig(config.bev)),
+      correction_(ElevationCorrection::fromConfig(config.sensor)),
+      ground_band_(GroundBand::fromConfig(config.ground)),
+      normal_params_(NormalParams::fromConfig(config.normals, spherical_)),
+      gates_(CorrespondenceGates::fromConfig(config.registration)),
+      pixels_(static_cast<size_t>(spherical_.rows) * spherical_.cols),
+      cells_(static_cast<size_t>(bev_.rows) * bev_.cols) {
+  for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  allocate();
+  clearDevice();
+}
+
+void CudaBackend::allocate() {
+  ring_rows_device_.reserve(ring_rows_.size());
+  check(cudaMemcpy(ring_rows_device_.data(), ring_rows_.data(), ring_rows_.size() * sizeof(int), cudaMemcpyHostToDevice),
+        "uploading the beam rows");
+  scan_image_.allocate(pixels_);
+  point_indices_.reserve(pixels_);
+  labels_.reserve(pixels_);
+  pixel_keys_.reserve(pixels_);
+  registration_flags_.reserve(pixels_);
+  registration_offsets_.reserve(pixels_);
+  registration_pixels_.reserve(pixels_);
+  scan_ground_.allocate(cells_, pixels_);  // one ground point per pixel at most
+  for (int buffer = 0; buffer < 2; ++buffer) {
+    model_image_[buffer].allocate(pixels_);
+    model_ground_[buffer].allocate(cells_, cells_);  // one point per cell at most
+  }
+  model_ground_normals_.reserve(cells_);
+  // A fusion's sources are the model's points (at most one per cell) and the scan's (at most one per pixel).
+  const size_t sources = cells_ + pixels_;
+  cell_keys_.reserve(cells_);
+  first_sources_.reserve(cells_);
+  source_cells_.reserve(sources);
+  first_flags_.reserve(sources);
+  source_offsets_.reserve(sources);
+  scan_scratch_bytes_ = exclusiveSumScratchBytes(static_cast<int>(sources));
+  scan_scratch_.reserve(scan_scratch_bytes_);
+  counts_.reserve(kCounts);
+  host_counts_.reserve(kCounts);
+  partial_sums_.reserve(kTerms * kReductionBlocks);
+  term_sums_.reserve(kTerms);
+  host_term_sums_.reserve(kTerms);
+}
+
+// Empty images and maps, and the compaction scratch at "none" (all bytes 0xff), as the kernels expect.
+void CudaBackend::clearDevice() {
+  const cudaStream_t stream = stream_.get();
+  for (const SphericalBuffers* image : {&scan_image_, &model_image_[0], &model_image_[1]}) {
+    clear(image->vertices, pixels_, 0, stream);
+    clear(image->normals, pixels_, 0, stream);
+    clear(image->ranges, pixels_, 0, stream);
+    clear(image->stamps, pixels_, 0, stream);
+  }
+  clear(point_indices_, pixels_, 0xff, stream);
+  clear(labels_, pixels_, 0, stream);
+  for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1]}) {
+    clear(map->point_of_cell, cells_, 0xff, stream);
+  }
+  clear(cell_keys_, cells_, 0xff, stream);
+  clear(first_sources_, cells_, 0xff, stream);
+  clear(counts_, kCounts, 0, stream);
+  for (int count = 0; count < kCounts; ++count) host_counts_[count] = 0;
+  synchronize();
+}
+
+void CudaBackend::synchronize() {
+  check(cudaStreamSynchronize(stream_.get()), "running the CUDA stages");
+  model_points_fetched_ = true;
+}
+
+void CudaBackend::fetchCount(int count) {
+  check(cudaMemcpyAsync(&host_counts_[count], counts_.data() + count, sizeof(int), cudaMemcpyDeviceToHost,
+                        stream_.get()),
+        "copying a count to the host");
+}
+
+int CudaBackend::modelPoints() {
+  if (!model_points_fetched_) synchronize();
+  return host_counts_[kModelPoints + current_];
+}
+
+DeviceScan CudaBackend::deviceScan() const {
+  return {spherical_.rows,         spherical_.cols,        scan_image_.vertices.data(), scan_image_.normals.data(),
+          scan_image_.ranges.data(), scan_image_.stamps.data(), point_indices_.data(),  labels_.data()};
+}
+
+DeviceModelImage CudaBackend::deviceModel(int buffer) const {
+  const SphericalBuffers& image = model_image_[buffer];
+  return {spherical_.rows, spherical_.cols, image.vertices.data(), image.normals.data(), image.ranges.data(),
+          image.stamps.data()};
+}
+
+DeviceBev CudaBackend::deviceBev(const BevBuffers& buffers, int count) const {
+  return {buffers.point_of_cell.data(), buffers.cells.data(),  buffers.vertices.data(),
+          buffers.ranges.data(),        buffers.stamps.data(), counts_.data() + count};
+}
+
+CellCompaction CudaBackend::compaction() const {
+  return {cell_keys_.data(),      first_sources_.data(), source_cells_.data(),  first_flags_.data(),
+          source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
+}
+
+// Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
+void CudaBackend::upload(const PointCloud& cloud) {
+  const size_t count = cloud.points.size();
+  uploaded_rings_ = !ring_rows_.empty() && cloud.ring.size() == count;
+  staged_points_.reserve(count);
+  points_.reserve(count);
+  if (uploaded_rings_) {
+    staged_rings_.reserve(count);
+    rings_.reserve(count);
+  }
+  const Clock::time_point staging_start = Clock::now();
+  if (count > 0) {
+    std::memcpy(staged_points_.data(), cloud.points.data(), count * sizeof(Float3));
+    if (uploaded_rings_) std::memcpy(staged_rings_.data(), cloud.ring.data(), count * sizeof(uint16_t));
+  }
+  upload_milliseconds_ = std::chrono::duration<double, std::milli>(Clock::now() - staging_start).count();
+  const cudaStream_t stream = stream_.get();
+  check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
+  if (count > 0) {
+    check(cudaMemcpyAsync(points_.data(), staged_points_.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
+          "uploading the cloud");
+    if (uploaded_rings_) {
+      check(cudaMemcpyAsync(rings_.data(), staged_rings_.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice,
+                            stream),
+            "uploading the rings");
+    }
+  }
+  check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
+}
+
+size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp) {
+  upload(cloud);
+  const UploadedCloud uploaded{points_.data(), uploaded_rings_ ? rings_.data() : nullptr,
+                               static_cast<int>(cloud.points.size())};
+  cuda::projectScan(uploaded, spherical_, correction_, ring_rows_device_.data(), static_cast<int>(ring_rows_.size()),
+                    stamp, pixel_keys_.data(), deviceScan(), counts_.data() + kOccupiedPixels, stream_.get());
+  fetchCount(kOccupiedPixels);
+  synchronize();  // the caller needs the count; the pinned staging buffer is free again after this
+  float copy_milliseconds = 0.0f;
+  check(cudaEventElapsedTime(&copy_milliseconds, upload_start_.get(), upload_end_.get()), "cudaEventElapsedTime");
+  upload_milliseconds_ += copy_milliseconds;
+  scan_view_current_ = false;
+  return static_cast<size_t>(host_counts_[kOccupiedPixels]);
+}
+
+void CudaBackend::segmentGround() {
+  if (config_.registration.terms == CostTerms::spherical_all) {
+    cuda::labelAllNonground(deviceScan(), stream_.get());
+  } else {
+    cuda::segmentGround(deviceScan(), ground_band_, stream_.get());
+  }
+  scan_view_current_ = false;
+}
+
+void CudaBackend::estimateNormals() {
+  const FlaggedList registration{registration_flags_.data(),  registration_offsets_.data(),
+                                 registration_pixels_.data(), counts_.data() + kRegistrationPixels,
+                                 scan_scratch_.data(),        scan_scratch_bytes_};
+  cuda::estimateNormals(deviceScan(), normal_params_, registration, stream_.get());
+  scan_view_current_ = false;
+}
+
+void CudaBackend::buildGroundMap() {
+  cuda::buildGroundMap(deviceScan(), bev_, scanGroundMap(), compaction(), stream_.get());
+  scan_ground_view_current_ = false;
+}
+
+NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+  const CostTerms terms = config_.registration.terms;
+  LinearizeInputs inputs{};
+  inputs.nonground = terms != CostTerms::bev_ground;
+  inputs.ground = terms == CostTerms::fused || terms == CostTerms::bev_ground;
+  inputs.scan = deviceScan();
+  inputs.registration_pixels = registration_pixels_.data();
+  inputs.registration_count = counts_.data() + kRegistrationPixels;
+  inputs.model = deviceModel(current_);
+  inputs.spherical = spherical_;
+  inputs.scan_ground = scanGroundMap();
+  inputs.model_ground = modelGroundMap(current_);
+  inputs.model_ground_normals = model_ground_normals_.data();
+  inputs.bev = bev_;
+  inputs.patch_radius = config_.bev.normal_patch_radius;
+  inputs.gates = gates_;
+  inputs.motion = toRigid3f(model_from_scan);
+  inputs.kernel_scale = kernel_scale;
+  cuda::linearize(inputs, partial_sums_.data(), term_sums_.data(), stream_.get());
+  check(cudaMemcpyAsync(host_term_sums_.data(), term_sums_.data(), kTerms * sizeof(DeviceTermSums),
+                        cudaMemcpyDeviceToHost, stream_.get()),
+        "copying the sums to the host");
+  synchronize();
+  NormalEquations sums;
+  sums.nonground = toTermSums(host_term_sums_[0]);
+  sums.ground = toTermSums(host_term_sums_[1]);
+  return sums;
+}
+
+void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) {
+  const cudaStream_t stream = stream_.get();
+  if (!model_initialized_ || config_.model.mode == RegistrationMode::frame_to_frame) {
+    cuda::copyScanToModel(deviceScan(), deviceModel(current_), stream);
+    cuda::copyGroundMap(scanGroundMap(), modelGroundMap(current_), stream);
+  } else {
+    const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
+    const float window = static_cast<float>(config_.model.time_window);
+    const int next = 1 - current_;
+    cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model, stamp, window,
+                             pixel_keys_.data(), deviceModel(next), stream);
+    cuda::fuseGroundModel(modelGroundMap(current_), modelPoints(), scanGroundMap(), static_cast<int>(pixels_), bev_,
+                          scan_from_model, stamp, window, modelGroundMap(next), compaction(), stream);
+    current_ = next;
+  }
+  model_initialized_ = true;
+  cuda::fitGroundNormals(modelGroundMap(current_), bev_, config_.bev.normal_neighbours,
+                         config_.bev.normal_patch_radius, model_ground_normals_.data(), stream);
+  fetchCount(kModelPoints + current_);
+  model_points_fetched_ = false;
+  model_view_current_ = false;
+}
+
+void CudaBackend::resetModel() {
+  synchronize();  // no copy into host_counts_ may be under way while it is written below
+  const cudaStream_t stream = stream_.get();
+  clear(model_image_[current_].ranges, pixels_, 0, stream);
+  clear(model_image_[current_].normals, pixels_, 0, stream);
+  cuda::clearGroundMap(modelGroundMap(current_), stream);
+  host_counts_[kModelPoints + current_] = 0;
+  model_initialized_ = false;
+  model_view_current_ = false;
+}
+
+const ScanImage& CudaBackend::scan() {
+  if (scan_view_current_) return scan_view_;
+  if (scan_view_.label.empty()) scan_view_.resize(spherical_.rows, spherical_.cols);
+  const cudaStream_t stream = stream_.get();
+  copyToHost(scan_view_.image.vertex, scan_image_.vertices.data(), pixels_, stream);
+  copyToHost(scan_view_.image.normal, scan_image_.normals.data(), pixels_, stream);
+  copyToHost(scan_view_.image.range, scan_image_.ranges.data(), pixels_, stream);
+  copyToHost(scan_view_.image.stamp, scan_image_.stamps.data(), pixels_, stream);
+  copyToHost(scan_view_.point_index, point_indices_.data(), pixels_, stream);
+  copyToHost(scan_view_.label, labels_.data(), pixels_, stream);
+  synchronize();
+  scan_view_current_ = true;
+  return scan_view_;
+}
+
+// The compact arrays as they are on the device, and the grid rebuilt from them: the device grid holds
+// the index of each point at its cell and -1 everywhere else, and so does the view.
+void CudaBackend::copyBevView(const BevBuffers& buffers, int points, BevImage& view) {
+  if (view.point_of_cell.empty()) view.resize(bev_.rows, bev_.cols);
+  view.clear();
+  view.cell.resize(points);
+  view.vertex.resize(points);
+  view.range.resize(points);
+  view.stamp.resize(points);
+  const cudaStream_t stream = stream_.get();
+  copyToHost(view.cell, buffers.cells.data(), points, stream);
+  copyToHost(view.vertex, buffers.vertices.data(), points, stream);
+  copyToHost(view.range, buffers.ranges.data(), points, stream);
+  copyToHost(view.stamp, buffers.stamps.data(), points, stream);
+  synchronize();
+  for (int point = 0; point < points; ++point) view.point_of_cell[view.cell[point]] = point;
+}
+
+const BevImage& CudaBackend::scanGround() {
+  if (scan_ground_view_current_) return scan_ground_view_;
+  fetchCount(kScanGroundPoints);
+  synchronize();
+  copyBevView(scan_ground_, host_counts_[kScanGroundPoints], scan_ground_view_);
+  scan_ground_view_current_ = true;
+  return scan_ground_view_;
+}
+
+const Model& CudaBackend::model() {
+  if (model_view_current_) return model_view_;
+  if (model_view_.nonground.range.empty()) model_view_.nonground.resize(spherical_.rows, spherical_.cols);
+  const SphericalBuffers& image = model_image_[current_];
+  const cudaStream_t stream = stream_.get();
+  copyToHost(model_view_.nonground.vertex, image.vertices.data(), pixels_, stream);
+  copyToHost(model_view_.nonground.normal, image.normals.data(), pixels_, stream);
+  copyToHost(model_view_.nonground.range, image.ranges.data(), pixels_, stream);
+  copyToHost(model_view_.nonground.stamp, image.stamps.data(), pixels_, stream);
+  copyBevView(model_ground_[current_], modelPoints(), model_view_.ground);
+  model_view_.initialized = model_initialized_;
+  model_view_current_ = true;
+  return model_view_;
+}
+
+}  // namespace elo::cuda

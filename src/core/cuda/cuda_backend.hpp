@@ -1,0 +1,139 @@
+// The CUDA implementation of the backend interface: the stages of src/core/cuda/*.cu, queued on one
+// stream over device buffers that mirror include/elo/types.hpp and are allocated once, in the
+// constructor (only the cloud upload grows, when a scan has more points than any before). The scan
+// goes up through pinned memory. The host views are copied back when asked for, and only when the
+// device buffers changed since.
+#pragma once
+
+#include <vector>
+
+#include "core/cuda/device_buffer.hpp"
+#include "core/cuda/kernels.hpp"
+#include "elo/backend.hpp"
+
+namespace elo::cuda {
+
+class CudaBackend final : public Backend {
+ public:
+  explicit CudaBackend(const Config& config);
+
+  const char* name() const override { return "cuda"; }
+  size_t projectScan(const PointCloud& cloud, float stamp) override;
+  void segmentGround() override;
+  void estimateNormals() override;
+  void buildGroundMap() override;
+  NormalEquations linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) override;
+  void updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) override;
+  void resetModel() override;
+
+  const ScanImage& scan() override;
+  const BevImage& scanGround() override;
+  const Model& model() override;
+
+  void synchronize() override;
+  double lastUploadMilliseconds() const override { return upload_milliseconds_; }
+
+ private:
+  struct SphericalBuffers {
+    DeviceArray<Float3> vertices;
+    DeviceArray<Float3> normals;
+    DeviceArray<float> ranges;
+    DeviceArray<float> stamps;
+
+    void allocate(size_t pixels);
+  };
+  struct BevBuffers {
+    DeviceArray<int32_t> point_of_cell;
+    DeviceArray<int32_t> cells;
+    DeviceArray<Float3> vertices;
+    DeviceArray<float> ranges;
+    DeviceArray<float> stamps;
+
+    void allocate(size_t grid_cells, size_t points);
+  };
+  // The counts the kernels write, at these indices of counts_ (and host_counts_, their pinned copy); the
+  // point counts of the two model buffers are at kModelPoints and kModelPoints + 1.
+  enum Count { kOccupiedPixels, kRegistrationPixels, kScanGroundPoints, kModelPoints, kCounts = kModelPoints + 2 };
+
+  void allocate();
+  void clearDevice();
+  void upload(const PointCloud& cloud);
+  DeviceScan deviceScan() const;
+  DeviceModelImage deviceModel(int buffer) const;
+  DeviceBev deviceBev(const BevBuffers& buffers, int count) const;
+  DeviceBev scanGroundMap() const { return deviceBev(scan_ground_, kScanGroundPoints); }
+  DeviceBev modelGroundMap(int buffer) const { return deviceBev(model_ground_[buffer], kModelPoints + buffer); }
+  CellCompaction compaction() const;
+  // Copies count `count` into host_counts_ once the stream gets there.
+  void fetchCount(int count);
+  // The current model's point count, waiting for the stream when its copy may still be under way.
+  int modelPoints();
+  void copyBevView(const BevBuffers& buffers, int points, BevImage& view);
+
+  Config config_;
+  SphericalProjection spherical_;
+  BevProjection bev_;
+  ElevationCorrection correction_;
+  GroundBand ground_band_;
+  NormalParams normal_params_;
+  CorrespondenceGates gates_;
+  size_t pixels_;
+  size_t cells_;
+  std::vector<int> ring_rows_;
+
+  Stream stream_;
+  Event upload_start_;
+  Event upload_end_;
+  double upload_milliseconds_ = 0.0;
+  bool uploaded_rings_ = false;
+
+  // The cloud, staged in pinned memory.
+  PinnedArray<Float3> staged_points_;
+  PinnedArray<uint16_t> staged_rings_;
+  DeviceArray<Float3> points_;
+  DeviceArray<uint16_t> rings_;
+  DeviceArray<int> ring_rows_device_;
+
+  // The scan image, its registration pixels and its ground map.
+  SphericalBuffers scan_image_;
+  DeviceArray<int32_t> point_indices_;
+  DeviceArray<PixelLabel> labels_;
+  DeviceArray<ClosestKey> pixel_keys_;
+  DeviceArray<int> registration_flags_;
+  DeviceArray<int> registration_offsets_;
+  DeviceArray<int> registration_pixels_;
+  BevBuffers scan_ground_;
+
+  // The model, twice: an update writes the buffer not in use (`1 - current_`), then switches to it.
+  SphericalBuffers model_image_[2];
+  BevBuffers model_ground_[2];
+  DeviceArray<Float3> model_ground_normals_;  // of the current model's points
+  int current_ = 0;
+  bool model_initialized_ = false;
+  bool model_points_fetched_ = true;  // host_counts_ holds the current model's point count
+
+  // Scratch of the BEV compaction (sources: every model point and every scan pixel).
+  DeviceArray<ClosestKey> cell_keys_;
+  DeviceArray<uint32_t> first_sources_;
+  DeviceArray<int> source_cells_;
+  DeviceArray<int> first_flags_;
+  DeviceArray<int> source_offsets_;
+  size_t scan_scratch_bytes_ = 0;
+  DeviceArray<unsigned char> scan_scratch_;
+
+  DeviceArray<int> counts_;
+  PinnedArray<int> host_counts_;
+  DeviceArray<DeviceTermSums> partial_sums_;
+  DeviceArray<DeviceTermSums> term_sums_;
+  PinnedArray<DeviceTermSums> host_term_sums_;
+
+  // Host views, filled on demand.
+  ScanImage scan_view_;
+  BevImage scan_ground_view_;
+  Model model_view_;
+  bool scan_view_current_ = false;
+  bool scan_ground_view_current_ = false;
+  bool model_view_current_ = false;
+};
+
+}  // namespace elo::cuda

@@ -1,0 +1,121 @@
+// The launches of each stage of the CUDA backend, declared for its host code (cuda_backend.cpp): device
+// buffers in, all work queued on `stream`, nothing waited for. The per-element math is the shared code of
+// src/core/common; the .cu files add the indexing, the atomics and the reductions.
+#pragma once
+
+#include <cuda_runtime_api.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/common/association.hpp"
+#include "core/common/closest_wins_key.hpp"
+#include "core/common/ground.hpp"
+#include "core/common/normals.hpp"
+#include "core/cuda/device_views.hpp"
+
+namespace elo::cuda {
+
+constexpr uint32_t kNoSource = ~uint32_t{0};  // all bytes 0xff
+
+// Scratch of "closest wins per cell, in order of first arrival" (bev_map.cu). Per BEV cell: the
+// closest-wins key and the lowest source offered to it, both back to "none" after each use. Per source:
+// its cell (-1: none), whether it arrived first in that cell, and the exclusive sum of those flags.
+struct CellCompaction {
+  ClosestKey* cell_keys;
+  uint32_t* first_sources;
+  int* source_cells;
+  int* first_flags;
+  int* offsets;
+  void* scan_scratch;  // for exclusiveSum()
+  size_t scan_scratch_bytes;
+};
+
+// A list of the flagged items of a range, in order (the registration pixels).
+struct FlaggedList {
+  int* flags;
+  int* offsets;
+  int* items;
+  int* count;
+  void* scan_scratch;  // for exclusiveSum()
+  size_t scan_scratch_bytes;
+};
+
+// compaction.cu: offsets[i] = flags[0] + ... + flags[i-1], and the scratch that needs.
+size_t exclusiveSumScratchBytes(int max_items);
+void exclusiveSum(const int* flags, int* offsets, int items, void* scratch, size_t scratch_bytes, cudaStream_t stream);
+
+// projection.cu: the closest point of the uploaded cloud per pixel (Sec. III-B.1); `rings` is null when
+// the cloud has no ring field. Counts the occupied pixels into `*occupied`.
+struct UploadedCloud {
+  const Float3* points;
+  const uint16_t* rings;
+  int count;
+};
+void projectScan(const UploadedCloud& cloud, const SphericalProjection& projection,
+                 const ElevationCorrection& correction, const int* ring_rows, int ring_count, float stamp,
+                 ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied, cudaStream_t stream);
+
+// ground_segmentation.cu (Sec. III-C.1).
+void segmentGround(const DeviceScan& scan, const GroundBand& band, cudaStream_t stream);
+void labelAllNonground(const DeviceScan& scan, cudaStream_t stream);
+
+// normal_estimation.cu: the normals of the non-ground pixels (Sec. III-B.3-4), and the list of the
+// non-ground pixels with a normal, in pixel order.
+void estimateNormals(const DeviceScan& scan, const NormalParams& params, const FlaggedList& registration_pixels,
+                     cudaStream_t stream);
+
+// bev_map.cu: BEV maps (Sec. III-C.2, III-D). Each keeps the closest point per cell, its points in the
+// order the CPU backend inserts them (see bev_map.cu).
+void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, const DeviceBev& ground,
+                    const CellCompaction& compaction, cudaStream_t stream);
+// `model_points`: the model's point count; `scan_slots`: a bound on the scan's (its pixel count).
+void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
+                     const BevProjection& projection, const Rigid3f& scan_from_model, float now, float time_window,
+                     const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream);
+void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream);
+void clearGroundMap(const DeviceBev& map, cudaStream_t stream);
+// The normal of every model point (groundNormal() of association.hpp), into `normals`.
+void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
+                      Float3* normals, cudaStream_t stream);
+
+// model_update.cu: the non-ground model (Sec. III-D).
+void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
+                        const Rigid3f& scan_from_model, float now, float time_window, ClosestKey* pixel_keys,
+                        const DeviceModelImage& fused, cudaStream_t stream);
+void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
+
+// correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A). JtJ is summed as its upper
+// triangle, row by row.
+constexpr int kJtJValues = 21;
+constexpr int kTermValues = kJtJValues + 6 + 1;  // JtJ, Jte, squared error
+struct DeviceTermSums {
+  double values[kTermValues];
+  int candidates;
+  int inliers;
+};
+constexpr int kTerms = 2;  // 0: non-ground (E_S), 1: ground (E_G)
+// Fixed, so that every GPU sums in the same order: results are reproducible run to run and across GPUs.
+constexpr int kReductionBlocks = 256;
+
+struct LinearizeInputs {
+  bool nonground;  // which terms to sum; a term left out sums to zero
+  bool ground;
+  DeviceScan scan;
+  const int* registration_pixels;
+  const int* registration_count;
+  DeviceModelImage model;
+  SphericalProjection spherical;
+  DeviceBev scan_ground;
+  DeviceBev model_ground;
+  const Float3* model_ground_normals;
+  BevProjection bev;
+  int patch_radius;
+  CorrespondenceGates gates;
+  Rigid3f motion;
+  double kernel_scale;
+};
+// `partials`: kTerms * kReductionBlocks per-block sums; `results`: kTerms totals.
+void linearize(const LinearizeInputs& inputs, DeviceTermSums* partials, DeviceTermSums* results, cudaStream_t stream);
+
+}  // namespace elo::cuda

@@ -1,0 +1,67 @@
+// Sec. III-B.1 on the GPU: every point offers itself to its pixel with an atomicMin of its closest-wins
+// key, then every pixel takes its winner. The per-point math is scanPointPixel() (scan_projection.hpp),
+// the same as the CPU backend's, so both fill the same pixels with the same points.
+#include "core/common/scan_projection.hpp"
+#include "core/cuda/kernels.hpp"
+#include "core/cuda/launch.cuh"
+
+namespace elo::cuda {
+
+namespace {
+
+__global__ void offerPoints(UploadedCloud cloud, SphericalProjection projection, ElevationCorrection correction,
+                            const int* ring_rows, int ring_count, ClosestKey* pixel_keys) {
+  const int i = globalThread();
+  if (i >= cloud.count) return;
+  const int ring = cloud.rings != nullptr ? static_cast<int>(cloud.rings[i]) : kNoRing;
+  Float3 corrected;
+  int pixel = 0;
+  if (!scanPointPixel(projection, correction, cloud.points[i], ring, ring_rows, ring_count, corrected, pixel)) return;
+  atomicMin(&pixel_keys[pixel], closestWinsKey(norm(corrected), static_cast<uint32_t>(i)));
+}
+
+__global__ void takeWinners(const ClosestKey* pixel_keys, const Float3* points, ElevationCorrection correction,
+                            float stamp, DeviceScan scan, int* occupied) {
+  const int pixel = globalThread();
+  bool taken = false;
+  if (pixel < scan.pixels()) {
+    scan.normals[pixel] = Float3{0.0f, 0.0f, 0.0f};
+    const ClosestKey key = pixel_keys[pixel];
+    if (key == kNoClosestKey) {
+      scan.ranges[pixel] = 0.0f;
+      scan.point_indices[pixel] = -1;
+      scan.labels[pixel] = PixelLabel::empty;
+    } else {
+      const uint32_t index = closestWinsSource(key);
+      const Float3 point = correction.apply(points[index]);
+      scan.vertices[pixel] = point;
+      scan.ranges[pixel] = norm(point);
+      scan.stamps[pixel] = stamp;
+      scan.point_indices[pixel] = static_cast<int32_t>(index);
+      scan.labels[pixel] = PixelLabel::nonground;
+      taken = true;
+    }
+  }
+  // Every thread of the block reaches this (no early return above). One atomic per block.
+  const int block_count = __syncthreads_count(taken);
+  if (threadIdx.x == 0 && block_count > 0) atomicAdd(occupied, block_count);
+}
+
+}  // namespace
+
+void projectScan(const UploadedCloud& cloud, const SphericalProjection& projection,
+                 const ElevationCorrection& correction, const int* ring_rows, int ring_count, float stamp,
+                 ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied, cudaStream_t stream) {
+  check(cudaMemsetAsync(pixel_keys, 0xff, sizeof(ClosestKey) * scan.pixels(), stream), "clearing the pixel keys");
+  check(cudaMemsetAsync(occupied, 0, sizeof(int), stream), "clearing the occupied count");
+  if (cloud.count > 0) {
+    offerPoints<<<blocksFor(cloud.count), kThreads, 0, stream>>>(cloud, projection, correction, ring_rows, ring_count,
+                                                                 pixel_keys);
+    checkLaunch("offerPoints");
+  }
+  takeWinners<<<blocksFor(scan.pixels()), kThreads, 0, stream>>>(pixel_keys, cloud.points, correction, stamp, scan,
+                                                                 occupied);
+  checkLaunch("takeWinners");
+}
+
+}  // namespace elo::cuda

@@ -1,0 +1,27 @@
+// The PCD file format (ascii, binary and binary_compressed), parsed here rather than by PCL's reader
+// (not installed). PCL 1.13 trusts the header: a SIZE that contradicts TYPE makes it write past its
+// buffer, a header line with fewer values than FIELDS throws std::out_of_range, and a large POINTS
+// allocates before anything is checked. This parser checks every size against the file first, and a
+// malformed file is an IoError naming the file and the line.
+#pragma once
+
+#include <pcl/PCLPointField.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace elo::io_detail {
+
+struct PcdPoints {
+  std::vector<pcl::PCLPointField> fields;  // offset, datatype and count of each field within a point
+  size_t point_step = 0;                   // bytes per point
+  size_t count = 0;                        // width x height
+  std::vector<uint8_t> data;               // count x point_step bytes, each point packed as `fields` say
+};
+
+// `bytes` is the whole file, `path` its name for messages.
+PcdPoints parsePcd(const std::string& bytes, const std::string& path);
+
+}  // namespace elo::io_detail

@@ -1,0 +1,364 @@
+// The CUDA backend against the CPU backend on the same inputs, stage by stage: range images, point
+// indices, ground labels and BEV maps identical; normals within 1e-4; Gauss-Newton sums within 1e-6
+// (relative); poses within 1e-4 m and 1e-4 rad at every frame. These tests skip, saying why, where no
+// CUDA device is usable or the build has no CUDA backend. The factory tests run everywhere.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "analytic_scene.hpp"
+#include "elo/io/sequence.hpp"
+#include "elo/odometry.hpp"
+
+namespace elo {
+namespace {
+
+#define ELO_REQUIRE_CUDA()                                                                          \
+  do {                                                                                              \
+    const std::string reason = cudaUnavailableReason();                                             \
+    if (!reason.empty()) GTEST_SKIP() << "the CUDA backend cannot run here: " << reason;            \
+  } while (false)
+
+const std::string kRealScans = std::string(ELO_SHARED_DATA) + "/real/hdl64_drive_a";
+
+// Within 1e-4 m and 1e-4 rad, at every frame.
+constexpr double kPoseTolerance = 1e-4;
+// Normals: largest component difference where both backends have one, which must be the same pixels.
+// Built for a host with FMA (the default -march=native), the backends round alike and agree bit for bit
+// (test_shared_math.cpp checks the GPU's normal estimator so on the CPU).
+constexpr float kNormalTolerance = 1e-4f;
+
+Eigen::Isometry3d pose(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
+  const double d = M_PI / 180.0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw_deg * d, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch_deg * d, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll_deg * d, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() << x, y, z;
+  return T;
+}
+
+struct Backends {
+  std::unique_ptr<Backend> cpu;
+  std::unique_ptr<Backend> cuda;
+
+  explicit Backends(Config config) {
+    config.runtime.threads = 2;
+    config.runtime.backend = BackendKind::cpu;
+    cpu = makeBackend(config);
+    config.runtime.backend = BackendKind::cuda;
+    cuda = makeBackend(config);
+  }
+
+  // Projects the cloud and extracts its features on both.
+  void prepare(const PointCloud& cloud, float stamp) {
+    for (Backend* backend : {cpu.get(), cuda.get()}) {
+      backend->projectScan(cloud, stamp);
+      backend->segmentGround();
+      backend->estimateNormals();
+      backend->buildGroundMap();
+    }
+  }
+};
+
+// Counts the elements where `same(i)` fails, describing the first.
+template <typename Same>
+size_t countDifferences(size_t count, const Same& same, std::string& first) {
+  size_t differences = 0;
+  for (size_t i = 0; i < count; ++i) {
+    if (same(i)) continue;
+    if (differences++ == 0) first = "first at element " + std::to_string(i);
+  }
+  return differences;
+}
+
+void expectSameProjection(const ScanImage& cpu, const ScanImage& cuda) {
+  ASSERT_EQ(cpu.image.pixelCount(), cuda.image.pixelCount());
+  std::string first;
+  EXPECT_EQ(countDifferences(cpu.label.size(), [&](size_t p) { return cpu.point_index[p] == cuda.point_index[p]; }, first), 0u)
+      << "point indices, " << first;
+  EXPECT_EQ(countDifferences(cpu.label.size(), [&](size_t p) { return cpu.image.range[p] == cuda.image.range[p]; }, first), 0u)
+      << "ranges, " << first;
+  EXPECT_EQ(countDifferences(cpu.label.size(),
+                             [&](size_t p) { return !cpu.image.occupied(p) || cpu.image.vertex[p] == cuda.image.vertex[p]; },
+                             first),
+            0u)
+      << "vertices, " << first;
+  EXPECT_EQ(countDifferences(cpu.label.size(), [&](size_t p) { return cpu.label[p] == cuda.label[p]; }, first), 0u)
+      << "labels, " << first;
+}
+
+void expectAgreeingNormals(const SphericalImage& cpu, const SphericalImage& cuda) {
+  size_t with_normal = 0;
+  size_t presence_differs = 0;
+  float largest_difference = 0.0f;
+  for (size_t p = 0; p < cpu.pixelCount(); ++p) {
+    const bool cpu_has = cpu.occupied(p) && cpu.hasNormal(p);
+    const bool cuda_has = cuda.occupied(p) && cuda.hasNormal(p);
+    with_normal += cpu_has;
+    if (cpu_has != cuda_has) {
+      ++presence_differs;
+    } else if (cpu_has) {
+      largest_difference = std::max(largest_difference, (cpu.normal[p] - cuda.normal[p]).cwiseAbs().maxCoeff());
+    }
+  }
+  EXPECT_GT(with_normal, 0u);
+  EXPECT_EQ(presence_differs, 0u) << "of " << with_normal;
+  EXPECT_LT(largest_difference, kNormalTolerance);
+}
+
+// The model image: the same points in the same pixels, with normals that agree.
+void expectAgreeingModelImage(const SphericalImage& cpu, const SphericalImage& cuda) {
+  std::string first;
+  EXPECT_EQ(countDifferences(cpu.pixelCount(), [&](size_t p) { return cpu.range[p] == cuda.range[p]; }, first), 0u)
+      << "ranges, " << first;
+  EXPECT_EQ(countDifferences(cpu.pixelCount(),
+                             [&](size_t p) {
+                               return !cpu.occupied(p) ||
+                                      (cpu.vertex[p] == cuda.vertex[p] && cpu.stamp[p] == cuda.stamp[p]);
+                             },
+                             first),
+            0u)
+      << "vertices and stamps, " << first;
+  expectAgreeingNormals(cpu, cuda);
+}
+
+void expectSameGroundMap(const BevImage& cpu, const BevImage& cuda) {
+  ASSERT_EQ(cpu.size(), cuda.size());
+  EXPECT_EQ(cpu.cell, cuda.cell);
+  EXPECT_EQ(cpu.vertex, cuda.vertex);
+  EXPECT_EQ(cpu.range, cuda.range);
+  EXPECT_EQ(cpu.stamp, cuda.stamp);
+  EXPECT_TRUE(cpu.point_of_cell == cuda.point_of_cell);
+}
+
+void expectAgreeingSums(const TermSums& cpu, const TermSums& cuda) {
+  EXPECT_EQ(cpu.candidates, cuda.candidates);
+  EXPECT_EQ(cpu.inliers, cuda.inliers);
+  constexpr double kRelative = 1e-6;
+  EXPECT_LE((cpu.JtJ - cuda.JtJ).norm(), kRelative * cpu.JtJ.norm());
+  EXPECT_LE((cpu.Jte - cuda.Jte).norm(), kRelative * cpu.Jte.norm());
+  EXPECT_LE(std::abs(cpu.squared_error - cuda.squared_error), kRelative * cpu.squared_error);
+}
+
+void expectAgreeingPoses(const Eigen::Isometry3d& cpu, const Eigen::Isometry3d& cuda, size_t frame) {
+  EXPECT_LT((cpu.translation() - cuda.translation()).norm(), kPoseTolerance) << "frame " << frame;
+  EXPECT_LT(rotationAngle(cpu.inverse() * cuda), kPoseTolerance) << "frame " << frame;
+}
+
+PointCloud streetScan(const Config& config, const Eigen::Isometry3d& sensor_pose = Eigen::Isometry3d::Identity(),
+                      double stamp = 0.0, double range_noise = 0.0) {
+  return test::scanScene(test::streetScene(), config.sensor, sensor_pose, stamp, range_noise).cloud;
+}
+
+TEST(BackendAgreement, ProjectionFillsTheSamePixelsWithTheSamePoints) {
+  ELO_REQUIRE_CUDA();
+  Config kitti;
+  kitti.sensor.elevation_correction_deg = 0.195;
+  for (const bool ring : {false, true}) {
+    for (const Config& config : {Config(), kitti}) {
+      SCOPED_TRACE(std::string("ring ") + (ring ? "on" : "off") + ", elevation correction " +
+                   std::to_string(config.sensor.elevation_correction_deg));
+      PointCloud cloud = streetScan(config, Eigen::Isometry3d::Identity(), 0.0, 0.02);
+      if (!ring) cloud.ring.clear();
+      Backends backends(config);
+      EXPECT_EQ(backends.cpu->projectScan(cloud, 0.5f), backends.cuda->projectScan(cloud, 0.5f));
+      expectSameProjection(backends.cpu->scan(), backends.cuda->scan());
+    }
+  }
+}
+
+TEST(BackendAgreement, GroundLabelsAreIdentical) {
+  ELO_REQUIRE_CUDA();
+  Config all_points;
+  all_points.registration.terms = CostTerms::spherical_all;
+  for (const Config& config : {Config(), all_points}) {
+    Backends backends(config);
+    const PointCloud cloud = streetScan(config, Eigen::Isometry3d::Identity(), 0.0, 0.02);
+    for (Backend* backend : {backends.cpu.get(), backends.cuda.get()}) {
+      backend->projectScan(cloud, 0.0f);
+      backend->segmentGround();
+    }
+    expectSameProjection(backends.cpu->scan(), backends.cuda->scan());
+  }
+}
+
+TEST(BackendAgreement, NormalsAgreeForEveryMethod) {
+  ELO_REQUIRE_CUDA();
+  for (const NormalMethod method : {NormalMethod::range_adaptive, NormalMethod::eigen, NormalMethod::cross_product}) {
+    for (const double noise : {0.0, 0.02}) {
+      SCOPED_TRACE("method " + std::to_string(static_cast<int>(method)) + ", noise " + std::to_string(noise));
+      Config config;
+      config.normals.method = method;
+      Backends backends(config);
+      backends.prepare(streetScan(config, Eigen::Isometry3d::Identity(), 0.0, noise), 0.0f);
+      expectAgreeingNormals(backends.cpu->scan().image, backends.cuda->scan().image);
+    }
+  }
+}
+
+TEST(BackendAgreement, ScanGroundMapsAreIdenticalInTheSameOrder) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  Backends backends(config);
+  backends.prepare(streetScan(config, pose(-3, 0.5, 0, 0, 0, 10), 0.0, 0.02), 0.0f);
+  EXPECT_GT(backends.cpu->scanGround().size(), 10000u);
+  expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
+}
+
+TEST(BackendAgreement, GaussNewtonSumsAgreeForEveryCostVariant) {
+  ELO_REQUIRE_CUDA();
+  for (const CostTerms terms :
+       {CostTerms::fused, CostTerms::spherical_all, CostTerms::spherical_nonground, CostTerms::bev_ground}) {
+    SCOPED_TRACE("terms " + std::to_string(static_cast<int>(terms)));
+    Config config;
+    config.registration.terms = terms;
+    Backends backends(config);
+    backends.prepare(streetScan(config), 0.0f);
+    backends.cpu->updateModel(Eigen::Isometry3d::Identity(), 0.0f);
+    backends.cuda->updateModel(Eigen::Isometry3d::Identity(), 0.0f);
+    const Eigen::Isometry3d truth = pose(0.6, 0.15, 0.03, 0.3, -0.4, 1.5);
+    backends.prepare(streetScan(config, truth, 0.1, 0.02), 0.1f);
+    for (const Eigen::Isometry3d& guess : {Eigen::Isometry3d::Identity(), truth, pose(0.5, 0.1, 0.0, 0.0, 0.0, 1.0)}) {
+      for (const double kernel_scale : {0.0, 0.1, 0.4}) {
+        const NormalEquations cpu = backends.cpu->linearize(guess, kernel_scale);
+        const NormalEquations cuda = backends.cuda->linearize(guess, kernel_scale);
+        expectAgreeingSums(cpu.nonground, cuda.nonground);
+        expectAgreeingSums(cpu.ground, cuda.ground);
+      }
+    }
+  }
+}
+
+TEST(BackendAgreement, ModelUpdatesAgree) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.model.time_window = 0.35;  // points expire within the run
+  Backends backends(config);
+  Eigen::Isometry3d truth = pose(-20, 0, 0, 0, 0, 0);
+  Eigen::Isometry3d previous = truth;
+  for (int frame = 0; frame < 8; ++frame) {
+    backends.prepare(streetScan(config, truth, 0.1 * frame, 0.02), 0.1f * frame);
+    const Eigen::Isometry3d model_from_scan = previous.inverse() * truth;
+    backends.cpu->updateModel(model_from_scan, 0.1f * frame);
+    backends.cuda->updateModel(model_from_scan, 0.1f * frame);
+    const Model& cpu = backends.cpu->model();
+    const Model& cuda = backends.cuda->model();
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    expectSameGroundMap(cpu.ground, cuda.ground);
+    expectAgreeingModelImage(cpu.nonground, cuda.nonground);
+    EXPECT_EQ(cpu.initialized, cuda.initialized);
+    previous = truth;
+    truth = truth * pose(0.9, 0.0, 0.0, 0.0, 0.0, 0.7);
+  }
+}
+
+// Drives down the street with turning, accelerating motion in `mode`, on both backends.
+void expectAgreeingStreetDrive(RegistrationMode mode) {
+  Config config;
+  config.model.mode = mode;
+  config.runtime.threads = 2;
+  Odometry cpu(config);
+  config.runtime.backend = BackendKind::cuda;
+  Odometry cuda(config);
+  Eigen::Isometry3d truth = pose(-20, 0, 0, 0, 0, 0);
+  double speed = 8.0;
+  for (int frame = 0; frame < 25; ++frame) {
+    const PointCloud cloud = streetScan(config, truth, 0.1 * frame, 0.02);
+    const FrameResult a = cpu.process(cloud);
+    const FrameResult b = cuda.process(cloud);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    expectAgreeingPoses(a.pose, b.pose, frame);
+    speed += 0.3;
+    truth = truth * pose(speed * 0.1, 0.0, 0.0, 0.0, 0.0, std::sin(frame * 0.3) * 0.8);
+  }
+}
+
+TEST(BackendAgreement, PosesAgreeAtEveryFrameOfASimulatedDrive) {
+  ELO_REQUIRE_CUDA();
+  expectAgreeingStreetDrive(RegistrationMode::frame_to_model);
+  expectAgreeingStreetDrive(RegistrationMode::frame_to_frame);
+}
+
+TEST(BackendAgreement, RealScansAgreeStageByStageAndInPose) {
+  ELO_REQUIRE_CUDA();
+  if (!std::filesystem::is_directory(kRealScans)) {
+    GTEST_SKIP() << "real scans not found at " << kRealScans << " (shared data absent)";
+  }
+  const Sequence sequence(kRealScans);
+  {
+    Backends backends{Config()};
+    backends.prepare(sequence.load(0), 0.0f);
+    expectSameProjection(backends.cpu->scan(), backends.cuda->scan());
+    expectAgreeingNormals(backends.cpu->scan().image, backends.cuda->scan().image);
+    expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
+  }
+  for (const RegistrationMode mode : {RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame}) {
+    Config config;
+    config.model.mode = mode;
+    config.runtime.threads = 2;
+    Odometry cpu(config);
+    config.runtime.backend = BackendKind::cuda;
+    Odometry cuda(config);
+    for (size_t i = 0; i < sequence.size(); ++i) {
+      const PointCloud cloud = sequence.load(i);
+      expectAgreeingPoses(cpu.process(cloud).pose, cuda.process(cloud).pose, i);
+    }
+  }
+}
+
+TEST(BackendAgreement, GpuRunsAreReproducible) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  Odometry first(config);
+  Odometry second(config);
+  Eigen::Isometry3d truth = pose(-15, 0, 0, 0, 0, 0);
+  for (int frame = 0; frame < 6; ++frame) {
+    const PointCloud cloud = streetScan(config, truth, 0.1 * frame, 0.02);
+    EXPECT_EQ(first.process(cloud).pose.matrix(), second.process(cloud).pose.matrix()) << "frame " << frame;
+    truth = truth * pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
+  }
+}
+
+TEST(BackendFactory, CudaWithoutAUsableGpuFailsSayingWhy) {
+  const std::string reason = cudaUnavailableReason();
+  if (reason.empty()) GTEST_SKIP() << "a CUDA device is usable here";
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  try {
+    makeBackend(config);
+    FAIL() << "made a CUDA backend without a usable GPU";
+  } catch (const std::runtime_error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(reason), std::string::npos) << message;
+    EXPECT_NE(message.find("runtime.backend_fallback"), std::string::npos) << message;
+  }
+}
+
+TEST(BackendFactory, CudaFallsBackToTheCpuWithAWarningWhenAllowed) {
+  const std::string reason = cudaUnavailableReason();
+  if (reason.empty()) GTEST_SKIP() << "a CUDA device is usable here";
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  config.runtime.backend_fallback = true;
+  std::string warning;
+  EXPECT_STREQ(makeBackend(config, &warning)->name(), "cpu");
+  EXPECT_NE(warning.find(reason), std::string::npos) << warning;
+  const Odometry odometry(config);
+  EXPECT_EQ(odometry.backendWarning(), warning);
+}
+
+TEST(BackendFactory, CudaWithAUsableGpuGivesTheCudaBackend) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  config.runtime.backend_fallback = true;
+  std::string warning;
+  EXPECT_STREQ(makeBackend(config, &warning)->name(), "cuda");
+  EXPECT_TRUE(warning.empty()) << warning;
+}
+
+}  // namespace
+}  // namespace elo

@@ -1,0 +1,216 @@
+// The per-element math both backends run (src/core/common), tested on the CPU. The CPU backend calls
+// most of it, so the stage tests cover it too; these tests cover what is new or only the CUDA backend
+// runs: the ported eigen-solver, the keys, transforms and point-to-plane terms, and windowNormal(), the
+// scalar normal estimator of the GPU, against the CPU backend's vectorised one.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <random>
+
+#include "analytic_scene.hpp"
+#include "core/common/closest_wins_key.hpp"
+#include "core/common/eigen_interop.hpp"
+#include "core/common/normals.hpp"
+#include "core/common/point_to_plane.hpp"
+#include "core/cpu/image_views.hpp"
+#include "elo/backend.hpp"
+
+namespace elo {
+namespace {
+
+SymmetricMatrix3 covarianceOf(const std::vector<Float3>& points) {
+  PointMoments moments;
+  for (const Float3& p : points) moments.add(p);
+  return moments.covariance();
+}
+
+Eigen::Matrix3f toEigen(const SymmetricMatrix3& m) {
+  Eigen::Matrix3f matrix;
+  matrix << m.xx, m.xy, m.xz, m.xy, m.yy, m.yz, m.xz, m.yz, m.zz;
+  return matrix;
+}
+
+// Points scattered with standard deviations `spread` along three random orthogonal axes.
+std::vector<Float3> scatteredPoints(std::mt19937& random, const Eigen::Vector3f& spread, int count = 40) {
+  std::normal_distribution<float> gaussian(0.0f, 1.0f);
+  const Eigen::Matrix3f axes = Eigen::Quaternionf::UnitRandom().toRotationMatrix();
+  std::vector<Float3> points;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3f local(spread.x() * gaussian(random), spread.y() * gaussian(random), spread.z() * gaussian(random));
+    points.push_back(toFloat3(axes * local + Eigen::Vector3f(0.3f, -0.2f, 0.1f)));
+  }
+  return points;
+}
+
+TEST(SymmetricEigen, ArctangentSineAndCosineAreAccurate) {
+  for (int i = 0; i <= 10000; ++i) {
+    const float angle = static_cast<float>(M_PI) * i / 10000.0f;
+    const float y = std::fabs(std::sin(angle));  // at pi, sinf is a hair below zero
+    const float x = std::cos(angle);
+    EXPECT_NEAR(detail::upperArctangent2(y, x), std::atan2(static_cast<double>(y), x), 4e-7);
+    const float small = static_cast<float>(M_PI / 4) * (i / 10000.0f);
+    EXPECT_NEAR(detail::sineNearZero(small), std::sin(static_cast<double>(small)), 2e-7);
+    EXPECT_NEAR(detail::cosineNearZero(small), std::cos(static_cast<double>(small)), 2e-7);
+  }
+}
+
+// Against Eigen's iterative solver in double. Like Eigen's closed form in float, ours keeps float
+// accuracy for an eigenvalue that stands apart, and about half of it for two that nearly coincide.
+TEST(SymmetricEigen, MatchesADoublePrecisionSolver) {
+  std::mt19937 random(7);
+  const Eigen::Vector3f spreads[] = {{1.0f, 0.5f, 0.2f}, {0.3f, 0.3f, 0.001f}, {2.0f, 0.01f, 0.01f}, {0.4f, 0.2f, 0.0f}};
+  for (int trial = 0; trial < 400; ++trial) {
+    const SymmetricMatrix3 covariance = covarianceOf(scatteredPoints(random, spreads[trial % 4]));
+    const SymmetricEigen ours = symmetricEigen(covariance);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> reference(toEigen(covariance).cast<double>());
+    const Eigen::Vector3d exact = reference.eigenvalues();
+    const double largest = exact(2);
+    for (int i = 0; i < 3; ++i) {
+      const double gap = std::min(i > 0 ? exact(i) - exact(i - 1) : largest, i < 2 ? exact(i + 1) - exact(i) : largest);
+      EXPECT_NEAR(ours.eigenvalues[i], exact(i), (gap > 1e-2 * largest ? 2e-6 : 1e-3) * largest) << "trial " << trial;
+    }
+    EXPECT_NEAR(norm(ours.smallest), 1.0f, 1e-5f);
+    // The smallest eigenvector is defined where the smallest eigenvalue stands apart.
+    if (exact(1) - exact(0) > 1e-2 * largest) {
+      EXPECT_GT(std::abs(toVec3f(ours.smallest).cast<double>().dot(reference.eigenvectors().col(0))), 1.0 - 1e-5)
+          << "trial " << trial;
+    }
+  }
+}
+
+TEST(SymmetricEigen, CollinearAndIsotropicPointsStillGiveAUnitOrthogonalVector) {
+  std::mt19937 random(3);
+  const std::vector<Float3> line = scatteredPoints(random, {1.0f, 0.0f, 0.0f});
+  const SymmetricEigen collinear = symmetricEigen(covarianceOf(line));
+  const Float3 direction = line[1] - line[0];
+  EXPECT_NEAR(norm(collinear.smallest), 1.0f, 1e-5f);
+  EXPECT_NEAR(dot(collinear.smallest, direction / norm(direction)), 0.0f, 1e-3f);
+  const SymmetricEigen isotropic = symmetricEigen({2.0f, 0.0f, 0.0f, 2.0f, 0.0f, 2.0f});
+  EXPECT_FLOAT_EQ(isotropic.eigenvalues[0], 2.0f);
+  EXPECT_FLOAT_EQ(isotropic.eigenvalues[2], 2.0f);
+  EXPECT_NEAR(norm(isotropic.smallest), 1.0f, 1e-6f);
+}
+
+TEST(PlaneFit, RecoversAPlaneAndItsFlatness) {
+  std::mt19937 random(11);
+  const std::vector<Float3> plane = scatteredPoints(random, {0.5f, 0.3f, 0.0f});
+  PointMoments moments;
+  for (const Float3& p : plane) moments.add(p - plane[0]);
+  const PlaneFit fit = fitPlane(moments);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_LT(fit.curvature, 1e-5f);
+  EXPECT_LT(std::abs(dot(fit.normal, plane[1] - plane[0])), 1e-4f);
+  EXPECT_LT(std::abs(dot(fit.normal, plane[2] - plane[0])), 1e-4f);
+  PointMoments two;
+  two.add(plane[0]);
+  two.add(plane[1]);
+  EXPECT_FALSE(fitPlane(two).valid);
+}
+
+TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsARing) {
+  // z = 0.05 x - 0.02 y - 1.73: normal (-0.05, 0.02, 1), normalised.
+  std::vector<Float3> patch;
+  for (int i = 0; i < 5; ++i) {
+    const float x = 10.0f + 0.07f * i;
+    const float y = 2.0f + 0.05f * ((i * 3) % 5);
+    patch.push_back({x, y, 0.05f * x - 0.02f * y - 1.73f});
+  }
+  const Float3 normal = groundPlaneNormal(patch.data(), 5, patch[0]);
+  const Eigen::Vector3f expected = Eigen::Vector3f(-0.05f, 0.02f, 1.0f).normalized();
+  EXPECT_GT(toVec3f(normal).dot(expected), 1.0f - 1e-6f);
+  std::vector<Float3> ring;
+  for (int i = 0; i < 5; ++i) ring.push_back({10.0f + 0.1f * i, 2.0f, -1.73f});  // one line in x-y
+  EXPECT_TRUE(isZero(groundPlaneNormal(ring.data(), 5, ring[0])));
+}
+
+TEST(ClosestWinsKey, CloserWinsTiesGoToTheLowerSourceAndNoneLosesToAll) {
+  EXPECT_LT(closestWinsKey(4.9f, 1000), closestWinsKey(5.0f, 3));
+  EXPECT_LT(closestWinsKey(5.0f, 3), closestWinsKey(5.0f, 4));
+  EXPECT_LT(closestWinsKey(119.9f, ~uint32_t{0} - 1), kNoClosestKey);
+  const ClosestKey key = closestWinsKey(12.375f, 98765);
+  EXPECT_EQ(closestWinsSource(key), 98765u);
+  EXPECT_EQ(closestWinsRange(key), 12.375f);
+}
+
+Eigen::Isometry3d somePose() {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() << 0.7, -0.1, 0.02;
+  return pose;
+}
+
+TEST(Rigid3f, AppliesTheEigenTransform) {
+  const Eigen::Isometry3d pose = somePose();
+  const Rigid3f rigid = toRigid3f(pose);
+  const Eigen::Vector3f p(12.0f, -3.5f, -1.6f);
+  EXPECT_TRUE(toVec3f(rigid.apply(toFloat3(p))).isApprox((pose * p.cast<double>()).cast<float>(), 1e-6f));
+  EXPECT_TRUE(toVec3f(rigid.rotate(toFloat3(p))).isApprox((pose.linear() * p.cast<double>()).cast<float>(), 1e-6f));
+}
+
+TEST(PointToPlane, ResidualJacobianAndGemanMcClureWeight) {
+  const Float3 moved{10.0f, 2.0f, 0.5f};
+  const Float3 vertex{10.1f, 2.0f, 0.4f};
+  const Float3 normal{-1.0f, 0.0f, 0.0f};
+  const PointToPlane term = pointToPlane(moved, vertex, normal, 0.0);
+  EXPECT_NEAR(term.residual, 0.1, 1e-6);
+  EXPECT_EQ(term.weight, 1.0);
+  const Float3 moment = cross(moved, normal);
+  const double expected[6] = {-1.0, 0.0, 0.0, moment.x, moment.y, moment.z};
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(term.jacobian[i], expected[i]);
+  EXPECT_DOUBLE_EQ(gemanMcClureWeight(0.0, 0.1), 1.0);
+  EXPECT_DOUBLE_EQ(gemanMcClureWeight(0.1, 0.1), 0.25);  // (s^2 / (s^2 + e^2))^2 at e = s
+}
+
+// Normals of the CPU backend's and of windowNormal() / crossProductNormal() over the same scan.
+struct NormalComparison {
+  size_t cpu_normals = 0;
+  size_t presence_differs = 0;
+  float largest_difference = 0.0f;  // largest component difference where both have one
+};
+
+NormalComparison compareWithScalarEstimator(NormalMethod method, double range_noise) {
+  Config config;
+  config.normals.method = method;
+  config.runtime.threads = 2;
+  const test::ScanWithTruth truth =
+      test::scanScene(test::streetScene(), config.sensor, Eigen::Isometry3d::Identity(), 0.0, range_noise);
+  std::unique_ptr<Backend> backend = makeBackend(config);
+  backend->projectScan(truth.cloud, 0.0f);
+  backend->segmentGround();
+  backend->estimateNormals();
+  const ScanImage& scan = backend->scan();
+  const cpu::ScanPixels pixels(scan);
+  const NormalParams params = NormalParams::fromConfig(config.normals, SphericalProjection::fromConfig(config.sensor));
+  NormalComparison comparison;
+  for (int pixel = 0; pixel < pixels.rows * pixels.cols; ++pixel) {
+    if (!pixels.usable(pixel)) continue;
+    const Float3 scalar = pixelNormal(pixels, pixel / pixels.cols, pixel % pixels.cols, params);
+    const bool cpu_has = scan.image.hasNormal(pixel);
+    comparison.cpu_normals += cpu_has;
+    if (cpu_has != !isZero(scalar)) {
+      ++comparison.presence_differs;
+    } else if (cpu_has) {
+      const float difference = (scan.image.normal[pixel] - toVec3f(scalar)).cwiseAbs().maxCoeff();
+      comparison.largest_difference = std::max(comparison.largest_difference, difference);
+    }
+  }
+  return comparison;
+}
+
+// gatherWindow() forms the window sums in the order and with the roundings of the CPU's vectorised lanes,
+// and the plane fit uses basic operations only, so the normals are the same bit for bit.
+TEST(SharedNormalEstimator, TheGpusScalarEstimatorGivesTheCpuBackendsNormalsBitForBit) {
+  for (const NormalMethod method : {NormalMethod::range_adaptive, NormalMethod::eigen, NormalMethod::cross_product}) {
+    for (const double noise : {0.0, 0.02}) {
+      const NormalComparison comparison = compareWithScalarEstimator(method, noise);
+      SCOPED_TRACE("method " + std::to_string(static_cast<int>(method)) + ", noise " + std::to_string(noise));
+      EXPECT_GT(comparison.cpu_normals, 10000u);
+      EXPECT_EQ(comparison.presence_differs, 0u);
+      EXPECT_EQ(comparison.largest_difference, 0.0f);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace elo

@@ -1,0 +1,88 @@
+// Degeneracy handling on a simulated tunnel: once inside, nothing constrains the forward translation.
+// Without the handling, Gauss-Newton follows the noise along it and the trajectory runs away; with it,
+// the scans are flagged degenerate along x and the forward motion continues at the velocity of the
+// approach, so drift stays as low as on an open road.
+#include <gtest/gtest.h>
+
+#include "elo/eval/evaluation.hpp"
+#include "elo/odometry.hpp"
+#include "elo/sim/simulation.hpp"
+
+namespace elo {
+namespace {
+
+struct OdometryRun {
+  OdometryRun(const char* name_, double threshold) : name(name_), odometry(configWithThreshold(threshold)) {}
+  static Config configWithThreshold(double threshold) {
+    Config config;
+    config.registration.degeneracy_threshold = threshold;
+    return config;
+  }
+
+  const char* name;
+  Odometry odometry;
+  std::vector<Eigen::Isometry3d> poses;
+  size_t degenerate_before_portal = 0;
+  size_t degenerate_inside = 0;
+  size_t scans_inside = 0;
+};
+
+// 160 scans (169 m) of the tunnel world's straight drive, HDL-64E, seed 3: up to cruise speed on the open
+// approach, through the portal 100 m after the start at scan 115, then 69 m inside.
+TEST(TunnelDegeneracy, HandlingKeepsTheForwardMotionThatTheTunnelCannotObserve) {
+  sim::SimulationSpec spec;
+  spec.world = sim::WorldFamily::tunnel;
+  spec.trajectory = sim::TrajectoryKind::straight;
+  spec.frames = 160;
+  spec.seed = 3;
+  const sim::Simulation simulation(spec);
+  constexpr double kPortal = 100.0;
+  // Past the portal by this much, the mouth behind the sensor no longer constrains anything.
+  constexpr double kDeepInside = kPortal + 10.0;
+
+  OdometryRun handled("with handling", RegistrationConfig().degeneracy_threshold);
+  OdometryRun unhandled("without", 0.0);
+  const std::vector<OdometryRun*> runs = {&handled, &unhandled};
+  std::vector<Eigen::Isometry3d> truth;
+  const Eigen::Isometry3d start = simulation.sensorPose(0);
+  for (int frame = 0; frame < simulation.frameCount(); ++frame) {
+    const PointCloud cloud = simulation.scan(frame).cloud;
+    truth.push_back(start.inverse() * simulation.sensorPose(frame));
+    const double travelled = truth.back().translation().x();
+    for (OdometryRun* run_pointer : runs) {
+      OdometryRun& run = *run_pointer;
+      const FrameResult result = run.odometry.process(cloud);
+      ASSERT_TRUE(result.processed) << run.name << ", frame " << frame << ": " << result.skip_reason;
+      run.poses.push_back(result.pose);
+      const Degeneracy& degeneracy = result.registration.degeneracy;
+      if (travelled < kPortal - 10.0 && degeneracy.any()) ++run.degenerate_before_portal;
+      if (travelled > kDeepInside) {
+        ++run.scans_inside;
+        if (degeneracy.any() && degeneracy.describe() == "x") ++run.degenerate_inside;
+      }
+    }
+  }
+
+  std::vector<double> drift;  // t_rel %, per run
+  for (const OdometryRun* run : runs) {
+    const TrajectoryEvaluation evaluation = evaluateTrajectory("tunnel", truth, run->poses);
+    drift.push_back(evaluation.drift.t_rel_percent);
+    const double end_error = (truth.back().inverse() * run->poses.back()).translation().norm();
+    std::cout << run->name << ": t_rel " << evaluation.drift.t_rel_percent << " %, r_rel "
+              << evaluation.drift.r_rel_deg_per_100m << " deg/100m, end error " << end_error << " m over "
+              << evaluation.length_m << " m; degenerate along x on " << run->degenerate_inside << " of "
+              << run->scans_inside << " scans inside" << std::endl;
+  }
+  EXPECT_EQ(handled.degenerate_before_portal, 0u) << "the open approach is well constrained";
+  EXPECT_GT(handled.scans_inside, 30u);
+  EXPECT_EQ(handled.degenerate_inside, handled.scans_inside) << "every scan deep inside lacks its forward motion";
+  EXPECT_EQ(unhandled.degenerate_inside, 0u) << "threshold 0 turns the handling off";
+  // Measured (2026-11-21): with the handling 0.164 % (0.31 m off at the end), without 55 % (147 m off:
+  // Gauss-Newton steps of metres along x, driven by noise, so that figure varies from build to build). A
+  // regression by half fails the first.
+  EXPECT_LT(drift[0], 1.5 * 0.164);
+  EXPECT_GT(drift[1], 10.0) << "without the handling the tunnel is expected to run away";
+}
+
+}  // namespace
+}  // namespace elo
