@@ -1,6 +1,8 @@
 # Entry points for a fresh Debian 12 machine. `make demo` installs what is missing, builds and runs the
 # odometry on a simulated drive; `make test` does the same and runs every test; `make bench` prints the
-# speed figures; `make accuracy` the accuracy table on simulated sequences.
+# speed figures; `make accuracy` the accuracy table on simulated sequences. `make test-sanitize` runs the
+# suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
+# `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs).
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
 export PATH := /usr/bin:$(PATH)
@@ -17,7 +19,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools
 
-.PHONY: deps build test bench demo accuracy soak clean
+.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -38,6 +40,44 @@ build: deps
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+# Sanitizer builds sit beside the normal one and are Release builds, like it (CMakeLists.txt,
+# ELO_SANITIZE). A report fails the test that caused it; test/sanitizers/ holds the suppressions of what
+# is not ours, each with its reason.
+ASAN_BUILD ?= build-asan
+TSAN_BUILD ?= build-tsan
+SANITIZER_FILES := $(CURDIR)/test/sanitizers
+SANITIZER_CMAKE := -DCMAKE_BUILD_TYPE=Release -DELO_SHARED_DATA=$(SHARED_DATA) \
+  -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
+ASAN_ENV := ASAN_OPTIONS=detect_leaks=1:check_initialization_order=1 \
+  LSAN_OPTIONS=suppressions=$(SANITIZER_FILES)/lsan.supp:print_suppressions=0 UBSAN_OPTIONS=print_stacktrace=1
+TSAN_ENV := TSAN_OPTIONS=suppressions=$(SANITIZER_FILES)/tsan.supp:history_size=7
+
+test-sanitize: test-asan test-tsan
+
+# Every test, the ROS ones included.
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD) $(SANITIZER_CMAKE) -DELO_SANITIZE=address,undefined
+	cmake --build $(ASAN_BUILD) -j$(JOBS)
+	cd $(ASAN_BUILD) && $(ASAN_ENV) ctest --output-on-failure -j$(JOBS)
+
+# The core library's tests: the threaded CPU kernels (TBB) and everything that calls them.
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD) $(SANITIZER_CMAKE) -DELO_SANITIZE=thread
+	cmake --build $(TSAN_BUILD) --target test_core -j$(JOBS)
+	cd $(TSAN_BUILD) && $(TSAN_ENV) ctest --output-on-failure -L '^core$$' -j$(JOBS)
+
+# libFuzzer over each reader of untrusted input (test/fuzz), FUZZ_SECONDS per target; tools/fuzz.sh
+# says where the corpus grows and where a crasher lands.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := fuzz_cloud_conversion fuzz_kitti_bin fuzz_pcd fuzz_kitti_text fuzz_config_yaml
+fuzz: DEB_PACKAGES += clang libclang-rt-14-dev
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DELO_FUZZ=ON \
+	  -DELO_SHARED_DATA=$(SHARED_DATA) -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
+	cmake --build $(FUZZ_BUILD) --target elo_fuzz_targets -j$(JOBS)
+	$(ASAN_ENV) tools/fuzz.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 bench: build
 	tools/bench.sh $(BUILD) $(SHARED_DATA)

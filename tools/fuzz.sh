@@ -31,7 +31,8 @@ for target in "$@"; do
     coverage=$(grep -o 'cov: [0-9]* ft: [0-9]* corp: [0-9]*' "$log" | tail -1)
     echo "$target: $runs inputs, $coverage, nothing found"
   else
-    tail -n 40 "$log"
+    # The report, from its first line (a sanitizer's, an uncaught exception's or a property's) on.
+    grep -m1 -A30 -E 'ERROR: |runtime error|terminate called|fuzz property violated' "$log" || tail -n 30 "$log"
     echo "$target: FAILED; the input is in $crashers/" >&2
     failed+=("$target")
   fi

@@ -149,7 +149,8 @@ FrameResult registerStandingStillPrior(const test::Scene& scene, const Eigen::Is
   config.model.motion_prior = MotionPrior::constant_velocity;
   Odometry odometry(config);
   for (const double stamp : {0.0, 0.1}) {
-    EXPECT_TRUE(odometry.process(test::scanScene(scene, config.sensor, Eigen::Isometry3d::Identity(), stamp).cloud).processed);
+    const PointCloud still = test::scanScene(scene, config.sensor, Eigen::Isometry3d::Identity(), stamp).cloud;
+    EXPECT_TRUE(odometry.process(still).processed);
   }
   return odometry.process(test::scanScene(scene, config.sensor, truth, 0.2).cloud);
 }
@@ -201,7 +202,8 @@ TEST(Degeneracy, WithoutAnInformedPriorEveryDirectionIsSolved) {
   Odometry odometry(config);
   const test::Scene scene = corridorScene();
   odometry.process(test::scanScene(scene, config.sensor, Eigen::Isometry3d::Identity(), 0.0).cloud);
-  const FrameResult result = odometry.process(test::scanScene(scene, config.sensor, pose(0.8, 0, 0, 0, 0, 0), 0.1).cloud);
+  const Eigen::Isometry3d truth = pose(0.8, 0.0, 0.0, 0.0, 0.0, 0.0);
+  const FrameResult result = odometry.process(test::scanScene(scene, config.sensor, truth, 0.1).cloud);
   ASSERT_TRUE(result.processed);
   EXPECT_EQ(result.registration.degeneracy.count, 0);
   EXPECT_LT(result.registration.degeneracy.eigenvalues[0], config.registration.degeneracy_threshold)

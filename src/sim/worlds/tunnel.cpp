@@ -33,12 +33,14 @@ constexpr double kCuttingHeight = 10.0;
 double crossSection(double distance) {
   const double road_edge = -kCrownSlope * kRoadHalfWidth;
   if (distance < kRoadHalfWidth) return -kCrownSlope * distance;
+  if (distance < kVergeEnd) {
+    return road_edge + kKerbHeight * smoothStep(kRoadHalfWidth, kRoadHalfWidth + kKerbWidth, distance);
+  }
   const double walkway = road_edge + kKerbHeight;
-  if (distance < kVergeEnd) return road_edge + kKerbHeight * smoothStep(kRoadHalfWidth, kRoadHalfWidth + kKerbWidth, distance);
   return walkway + (kCuttingHeight - walkway) * smoothStep(kVergeEnd, kCuttingEnd, distance);
 }
 
-// Where `along` metres into the lot lies relative to the tunnel, by distance along the route.
+// Whether `along` metres into the lot lies inside the tunnel, by distance along the route.
 bool insideTunnel(const Roadside& roadside, const Roadside::Lot& lot, double along) {
   const double from_start = lot.begin + along - roadside.routeStart();
   return from_start >= kPortalDistance && from_start < kPortalDistance + kTunnelLength;
