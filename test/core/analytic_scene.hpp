@@ -15,6 +15,18 @@
 
 namespace elo::test {
 
+// A pose from a translation and roll, pitch, yaw in degrees (applied x, then y, then z).
+inline Eigen::Isometry3d pose(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
+  const double d = M_PI / 180.0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw_deg * d, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch_deg * d, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll_deg * d, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() << x, y, z;
+  return T;
+}
+
 struct Box {
   Eigen::Vector3d min;
   Eigen::Vector3d max;

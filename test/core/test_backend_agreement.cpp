@@ -28,17 +28,7 @@ constexpr double kPoseTolerance = 1e-4;
 // (test_shared_math.cpp checks the GPU's normal estimator so on the CPU).
 constexpr float kNormalTolerance = 1e-4f;
 
-Eigen::Isometry3d pose(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
-  const double d = M_PI / 180.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw_deg * d, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(pitch_deg * d, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll_deg * d, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << x, y, z;
-  return T;
-}
-
+using test::pose;
 struct Backends {
   std::unique_ptr<Backend> cpu;
   std::unique_ptr<Backend> cuda;

@@ -124,17 +124,7 @@ TEST(Degeneracy, ThePriorContinuesAtConstantVelocityAlongTheDegenerateDirections
   EXPECT_NEAR(predicted.y(), 0.3, 1e-12) << "y: still extrapolated";
 }
 
-Eigen::Isometry3d pose(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
-  const double d = M_PI / 180.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw_deg * d, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(pitch_deg * d, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll_deg * d, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << x, y, z;
-  return T;
-}
-
+using test::pose;
 // An open-topped corridor: the ground and two parallel walls longer than the sensor's reach.
 test::Scene corridorScene() {
   test::Scene scene;

@@ -7,17 +7,7 @@
 namespace elo {
 namespace {
 
-Eigen::Isometry3d pose(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
-  const double d = M_PI / 180.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw_deg * d, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(pitch_deg * d, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll_deg * d, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << x, y, z;
-  return T;
-}
-
+using test::pose;
 double translationErrorMm(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.inverse() * b).translation().norm() * 1000.0;
 }
