@@ -8,7 +8,8 @@
 # SCANS defaults to 20000 (33 min at 10 Hz), RATE (playback speed) to 1. Environment: SOAK_BLOCK (scans
 # per table row, default 1000), SOAK_WARMUP (scans before the memory baseline, default 1000),
 # SOAK_RSS_TOLERANCE (MiB of growth allowed after warm-up, default 16), SOAK_BACKLOG (scans allowed to
-# wait for the nodelet after warm-up, default 10), SOAK_THREADS (odometry threads, default 2). The
+# wait for the nodelet after warm-up, default 10), SOAK_THREADS (odometry threads, default 2), SOAK_INPUT
+# (a sequence directory to play instead of the simulated lap, e.g. the real scans, to time the ROS layer). The
 # nodelet must keep up with RATE: on a loaded machine, lower it. Writes BUILD_DIR/soak/: sequence/ (kept
 # for the next run), roslaunch.log, player.log, report.txt. Exits with the monitor's status: 0 when the
 # memory stayed flat, the nodelet kept up and every scan is accounted for.
@@ -31,7 +32,11 @@ out=$(cd "$build/soak" && pwd)  # absolute: the ROS processes run elsewhere
 # One lap of the urban loop is 40 s (400 scans at 10 Hz): played end to end, it is one continuous drive.
 lap_frames=400
 sim_args="--world urban --trajectory loop --frames $lap_frames --seed 1 --sensor hdl64"
-if [ "$(cat "$out/sequence/.elo_sim_args" 2>/dev/null)" != "$sim_args" ]; then
+sequence="${SOAK_INPUT:-$out/sequence}"
+if [ -n "${SOAK_INPUT:-}" ]; then
+  [ -d "$SOAK_INPUT" ] || { echo "soak: SOAK_INPUT=$SOAK_INPUT is not a directory" >&2; exit 1; }
+  sequence=$(cd "$SOAK_INPUT" && pwd)
+elif [ "$(cat "$out/sequence/.elo_sim_args" 2>/dev/null)" != "$sim_args" ]; then
   echo "== simulating one lap of the urban loop ($lap_frames HDL-64E scans)"
   rm -rf "$out/sequence"
   # shellcheck disable=SC2086
@@ -71,7 +76,7 @@ echo "== playing $scans scans at ${rate}x; report every $block scans"
 "$bin/soak_monitor" --scans "$scans" --manager /elo/elo_manager --points /points --odom /elo/odom \
   --block "$block" --warmup "$warmup" --rss-tolerance "$tolerance" --backlog "$backlog" >"$out/report.txt" 2>&1 &
 monitor_pid=$!
-if ! "$bin/sequence_player" --input "$out/sequence" --topic /points --scans "$scans" --rate "$rate" \
+if ! "$bin/sequence_player" --input "$sequence" --topic /points --scans "$scans" --rate "$rate" \
   --subscribers 2 --progress "$block" | tee "$out/player.log"; then
   echo "soak: the player failed; see $out/roslaunch.log and $out/report.txt" >&2
   exit 1

@@ -29,7 +29,8 @@ Watches the odometry nodelet while a player publishes N scans: samples the resid
 its manager process every second, reads its diagnostics, and times each scan from the cloud's arrival
 to its odometry. When the nodelet's counters account for all N scans (processed, skipped, rejected or
 dropped), it prints per block of scans the processing time (the nodelet's, from its diagnostics), the
-latency (mean and 99th percentile) and the memory, then the totals. It exits 0 when, after warm-up,
+latency (mean and 99th percentile) and the memory, then the totals and the throughput (first cloud's
+arrival to last odometry). It exits 0 when, after warm-up,
 the memory grew by at most the tolerance and the nodelet kept up (at most --backlog scans waiting), and
 no scan is unexplained; 1 otherwise. A nodelet that falls behind queues every scan it has not yet
 processed, so its memory then says nothing about leaks: lower the rate.
@@ -232,6 +233,7 @@ class SoakMonitor {
     printTable();
     const bool memory_flat = reportMemory();
     const bool kept_up = reportBacklog();
+    reportThroughput();
     const size_t unexplained = reportScans();
     const bool passed = complete && memory_flat && kept_up && unexplained == 0;
     if (!complete) {
@@ -243,7 +245,11 @@ class SoakMonitor {
   }
 
  private:
-  void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud) { arrivals_[cloud->header.stamp] = ros::WallTime::now(); }
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {
+    const ros::WallTime now = ros::WallTime::now();
+    arrivals_[cloud->header.stamp] = now;
+    if (first_arrival_.isZero()) first_arrival_ = now;
+  }
 
   void onOdometry(const nav_msgs::OdometryConstPtr& odometry) {
     const ros::WallTime now = ros::WallTime::now();
@@ -254,6 +260,7 @@ class SoakMonitor {
       arrivals_.erase(arrivals_.begin(), std::next(arrival));
     }
     ++odometry_count_;
+    last_odometry_ = now;
   }
 
   void onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
@@ -350,6 +357,15 @@ class SoakMonitor {
     return kept_up;
   }
 
+  // With the player faster than the nodelet, this is the nodelet's throughput, ROS layer included.
+  void reportThroughput() const {
+    const double seconds = (last_odometry_ - first_arrival_).toSec();
+    if (odometry_count_ == 0 || seconds <= 0.0) return;
+    std::printf("throughput: %zu odometry messages in %.2f s from the first cloud's arrival to the last odometry "
+                "(%.1f scans/s)\n",
+                odometry_count_, seconds, odometry_count_ / seconds);
+  }
+
   // Prints where every scan went; returns how many are unexplained.
   size_t reportScans() const {
     const auto by_reason = [](const std::map<std::string, size_t>& counts) {
@@ -379,6 +395,7 @@ class SoakMonitor {
   ros::NodeHandle node_;
   ros::Subscriber odometry_, diagnostics_, points_;
   std::map<ros::Time, ros::WallTime> arrivals_;  // of clouds not yet answered by odometry, by stamp
+  ros::WallTime first_arrival_, last_odometry_;
   size_t odometry_count_ = 0;
   NodeCounters counters_;
   std::vector<Block> blocks_;

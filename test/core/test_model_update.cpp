@@ -12,7 +12,16 @@ struct Fixture {
   BevProjection bev = BevProjection::fromConfig(config.bev);
   cpu::ClosestWins winners;
 
-  Fixture() { winners.resize(static_cast<size_t>(spherical.rows) * spherical.cols); }
+  // The spherical model, a scan and the fused result: empty, of the projection's size.
+  SphericalImage model, fused;
+  ScanImage scan;
+
+  Fixture() {
+    winners.resize(static_cast<size_t>(spherical.rows) * spherical.cols);
+    model.resize(spherical.rows, spherical.cols);
+    fused.resize(spherical.rows, spherical.cols);
+    scan.resize(spherical.rows, spherical.cols);
+  }
 
   size_t pixelOf(const Vec3f& p) const {
     int row = 0;
@@ -30,12 +39,9 @@ struct Fixture {
 
 TEST(ModelUpdate, CloserPointWinsAndEmptyScanPixelsKeepTheModel) {
   Fixture f;
-  SphericalImage model;
-  model.resize(f.spherical.rows, f.spherical.cols);
-  ScanImage scan;
-  scan.resize(f.spherical.rows, f.spherical.cols);
-  SphericalImage fused;
-  fused.resize(f.spherical.rows, f.spherical.cols);
+  SphericalImage& model = f.model;
+  ScanImage& scan = f.scan;
+  SphericalImage& fused = f.fused;
 
   const Vec3f direction_a = Vec3f(1.0f, 0.1f, -0.05f).normalized();
   const Vec3f direction_b = Vec3f(0.2f, 1.0f, -0.05f).normalized();
@@ -62,12 +68,9 @@ TEST(ModelUpdate, CloserPointWinsAndEmptyScanPixelsKeepTheModel) {
 
 TEST(ModelUpdate, ModelPointsMoveIntoTheNewFrameAndExpire) {
   Fixture f;
-  SphericalImage model;
-  model.resize(f.spherical.rows, f.spherical.cols);
-  ScanImage scan;
-  scan.resize(f.spherical.rows, f.spherical.cols);
-  SphericalImage fused;
-  fused.resize(f.spherical.rows, f.spherical.cols);
+  SphericalImage& model = f.model;
+  ScanImage& scan = f.scan;
+  SphericalImage& fused = f.fused;
   const Vec3f fresh(20.0f, 2.0f, 0.5f);
   const Vec3f stale(-10.0f, 6.0f, 0.2f);
   Fixture::put(model, f.pixelOf(fresh), fresh, 5.0f);
