@@ -59,6 +59,10 @@ std::string usage() {
          "  --deskewed 0|1       1: each scan taken at one instant (default); 0: the sensor moves\n"
          "                       during the sweep and each point's time is its firing offset\n"
          "  --moving-cars N      cars driving along the road (default 0)\n"
+         "  --foliage-depth M    mean depth in metres that beams reach into leaves before echoing\n"
+         "                       (default 0: solid crowns)\n"
+         "  --mixed-pixels P     chance that a return at a depth edge comes from between the two\n"
+         "                       surfaces (default 0)\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -79,10 +83,10 @@ long long parseInteger(const std::string& flag, const std::string& text, long lo
 }
 
 std::map<std::string, std::string> readFlags(int argc, char** argv) {
-  static const std::vector<std::string> known = {"--world",  "--trajectory", "--poses",    "--frames",
-                                                 "--output", "--bag",      "--sensor",     "--seed",     "--config",
-                                                 "--noise",  "--dropout",    "--deskewed", "--moving-cars",
-                                                 "--threads"};
+  static const std::vector<std::string> known = {
+      "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
+      "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
+      "--mixed-pixels", "--threads"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -161,6 +165,16 @@ Options parseOptions(int argc, char** argv) {
     spec.lidar.deskewed = *deskewed == "1";
   }
   if (const auto cars = take("--moving-cars")) spec.moving_cars = static_cast<int>(parseInteger("--moving-cars", *cars, 0));
+  if (const auto depth = take("--foliage-depth")) {
+    spec.lidar.foliage_depth = elo::tools::parseNumber<double>("--foliage-depth", *depth);
+    if (spec.lidar.foliage_depth < 0.0) throw UsageError("--foliage-depth must not be negative");
+  }
+  if (const auto mixed = take("--mixed-pixels")) {
+    spec.lidar.mixed_pixel_probability = elo::tools::parseNumber<double>("--mixed-pixels", *mixed);
+    if (spec.lidar.mixed_pixel_probability < 0.0 || spec.lidar.mixed_pixel_probability > 1.0) {
+      throw UsageError("--mixed-pixels must lie in [0, 1]");
+    }
+  }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;
 }

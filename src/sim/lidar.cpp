@@ -32,6 +32,10 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options) : sensor_(
     throw std::invalid_argument("dropout probability must lie in [0, 1]");
   }
   if (options.detection_threshold < 0.0) throw std::invalid_argument("detection threshold must not be negative");
+  if (options.foliage_depth < 0.0) throw std::invalid_argument("foliage depth must not be negative");
+  if (options.mixed_pixel_probability < 0.0 || options.mixed_pixel_probability > 1.0) {
+    throw std::invalid_argument("mixed pixel probability must lie in [0, 1]");
+  }
   for (const float elevation : beamElevations(sensor)) {
     beam_directions_.emplace_back(std::cos(static_cast<double>(elevation)), std::sin(static_cast<double>(elevation)));
   }
@@ -102,6 +106,29 @@ bool Lidar::detected(const Return& result, Rng& rng) const {
   return !rng.chance(std::exp(-strength / options_.detection_threshold));
 }
 
+bool Lidar::atDepthEdge(const Return& previous, const Return& result, const Return& next) {
+  constexpr double kDepthEdge = 0.5;  // m
+  // A wall seen at a grazing angle also changes range fast, but smoothly: as fast before as after.
+  constexpr double kSmoothSlopeRatio = 4.0;
+  if (next.range <= 0.0) return false;
+  const double jump = std::abs(next.range - result.range);
+  const bool smooth = previous.range > 0.0 && jump <= kSmoothSlopeRatio * std::abs(result.range - previous.range);
+  return jump > kDepthEdge && !smooth;
+}
+
+double Lidar::clutteredRange(const Return& previous, const Return& result, const Return& next, Rng& rng) const {
+  // Random numbers are drawn only for the clutter asked for: without it the sweep is what it always was.
+  double range = result.range;
+  if (options_.foliage_depth > 0.0 && result.kind == SurfaceKind::foliage) {
+    range += std::min(-options_.foliage_depth * std::log(1.0 - rng.uniform()), 3.0 * options_.foliage_depth);
+  }
+  if (options_.mixed_pixel_probability > 0.0 && atDepthEdge(previous, result, next) &&
+      rng.chance(options_.mixed_pixel_probability)) {
+    range += rng.uniform() * (next.range - result.range);
+  }
+  return range;
+}
+
 SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const {
   // One random stream in firing order: the same seed gives the same sweep whatever the thread count.
   Rng rng(seed);
@@ -112,7 +139,13 @@ SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, 
     for (int beam = 0; beam < beams; ++beam) {
       const Return& result = returns[static_cast<size_t>(step) * beams + beam];
       if (result.range <= 0.0 || !detected(result, rng) || rng.chance(options_.dropout_probability)) continue;
-      const double range = result.range + rng.gaussian(0.0, sensor_.range_noise_stddev);
+      const auto at = [&](int other_step) -> const Return& {
+        return returns[static_cast<size_t>((other_step + azimuthSteps()) % azimuthSteps()) * beams + beam];
+      };
+      const Return& previous = at(step - 1);
+      const Return& next = at(step + 1);
+      const double range =
+          clutteredRange(previous, result, next, rng) + rng.gaussian(0.0, sensor_.range_noise_stddev);
       if (range < sensor_.min_range || range > sensor_.max_range) continue;
       scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
       scan.cloud.intensity.push_back(result.intensity);

@@ -97,7 +97,7 @@ std::optional<Hit> Scene::castPrimitives(const Ray& ray, double max_distance) co
       if (const auto hit = intersect(ray, primitive.shape, 0.0, nearest)) {
         nearest = hit->distance;
         best = Hit{hit->distance, hit->normal, reflectivityAt(primitive, ray.at(hit->distance), hit->normal),
-                   SurfaceKind::object};
+                   primitive.foliage ? SurfaceKind::foliage : SurfaceKind::object};
       }
     }
     // A hit inside this cell cannot be beaten by anything in a farther cell.

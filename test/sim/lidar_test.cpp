@@ -253,12 +253,76 @@ TEST(Lidar, WindowsReturnNothing) {
   EXPECT_GT(scan.cloud.size(), 0u);
 }
 
+// A wall of leaves: with foliage_depth each beam reaches in by an exponential depth, at most three
+// means; a plain wall beside it stays exact.
+TEST(Lidar, BeamsReachIntoLeavesBeforeTheyEcho) {
+  const double distance = 12.0;
+  Scene plain = wallScene(distance);
+  Primitive leaves{OrientedBox{Eigen::Vector3d(distance + 50.0, 0.0, 0.0), Eigen::Matrix3d::Identity(),
+                               Eigen::Vector3d(50.0, 1000.0, 1000.0)},
+                   0.6f};
+  leaves.foliage = true;
+  const Scene foliage(nullptr, {leaves});
+  LidarOptions options = exactOptions();
+  options.foliage_depth = 0.5;
+  const Lidar lidar(exactSensor(), options);
+
+  for (const Eigen::Vector3f& point : lidar.sweep(plain, atOrigin, 0.0, 1).cloud.points) {
+    EXPECT_NEAR(point.x(), distance, 1e-5);
+  }
+  const SimulatedScan scan = lidar.sweep(foliage, atOrigin, 0.0, 1);
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  double depth_sum = 0.0;
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    EXPECT_EQ(scan.surface[i], SurfaceKind::foliage);
+    const double exact_range = distance / scan.cloud.points[i].cast<double>().normalized().x();
+    const double depth = rangeOf(scan.cloud, i) - exact_range;
+    EXPECT_GE(depth, -1e-4);
+    EXPECT_LE(depth, 1.5 + 1e-4);
+    depth_sum += depth;
+  }
+  // The mean of min(X, 3 m) for X exponential with mean m is m (1 - e^-3).
+  EXPECT_NEAR(depth_sum / scan.cloud.size(), 0.5 * (1.0 - std::exp(-3.0)), 0.02);
+}
+
+// A box 6 m ahead in front of a wall 10 m ahead and 30 m wide: the firing beside each of the box's
+// vertical edges returns from between the two surfaces when mixed pixels are certain, and none does
+// without them. The wall seen obliquely (up to 56 degrees) is no depth edge.
+TEST(Lidar, MixedPixelsLieBetweenTheSurfacesOfADepthEdge) {
+  Scene scene(nullptr, {{OrientedBox{Eigen::Vector3d(60.0, 0.0, 0.0), Eigen::Matrix3d::Identity(),
+                                     Eigen::Vector3d(50.0, 15.0, 1000.0)},
+                         0.6f},
+                        {uprightBox(Eigen::Vector3d(6.5, 0.0, 0.0), Eigen::Vector3d(1.0, 2.0, 1000.0), 0.0), 0.6f}});
+  const auto between_count = [&](double probability) {
+    LidarOptions options = exactOptions();
+    options.mixed_pixel_probability = probability;
+    SensorConfig sensor = exactSensor();
+    sensor.beam_elevations_deg = {0.0};
+    const SimulatedScan scan = Lidar(sensor, options).sweep(scene, atOrigin, 0.0, 1);
+    int between = 0;
+    for (const Eigen::Vector3f& point : scan.cloud.points) {
+      EXPECT_TRUE(point.x() >= 6.0f - 1e-4f && point.x() <= 10.0f + 1e-4f) << point.transpose();
+      between += point.x() > 6.0f + 1e-3f && point.x() < 10.0f - 1e-3f ? 1 : 0;
+    }
+    return between;
+  };
+  EXPECT_EQ(between_count(0.0), 0);
+  // One firing at each of the two edges: the last on one surface before the range jumps.
+  EXPECT_EQ(between_count(1.0), 2);
+}
+
 TEST(Lidar, RejectsUnusableSensors) {
   SensorConfig sensor = exactSensor();
   sensor.azimuth_steps = 0;
   EXPECT_THROW(Lidar(sensor, exactOptions()), std::invalid_argument);
   LidarOptions options = exactOptions();
   options.dropout_probability = 1.5;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options = exactOptions();
+  options.foliage_depth = -0.1;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options = exactOptions();
+  options.mixed_pixel_probability = 2.0;
   EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
 }
 

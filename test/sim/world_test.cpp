@@ -83,6 +83,31 @@ TEST(World, TheRoadStaysClearOfObjectsOnRoutesThatTurnBack) {
   }
 }
 
+// The rails come in 4 m lots, each sharing its ends with the next: none may be taken for a revisit.
+TEST(World, HighwayGuardRailsRunUnbrokenOnBothSides) {
+  const double duration = 30.0;
+  const Route route = proceduralRoute(TrajectoryKind::straight, cruiseSpeed(WorldFamily::highway), duration);
+  const World world(WorldFamily::highway, route, WorldOptions{});
+  int casts = 0;
+  int rail_hits = 0;
+  // Level rays across the road every metre, at the height of the rail's beam (0.42-0.74 m above the
+  // verge, which lies 0.17 m below the middle lane there).
+  const double step = 1.0 / cruiseSpeed(WorldFamily::highway);
+  for (double time = 1.0; time < duration - 1.0; time += step) {
+    const Pose2 pose = route.at(time);
+    const Eigen::Vector2d left(-std::sin(pose.heading), std::cos(pose.heading));
+    const double height = world.ground().height(pose.x, pose.y) + 0.45;
+    for (const double side : {1.0, -1.0}) {
+      const Ray across{Eigen::Vector3d(pose.x, pose.y, height),
+                       Eigen::Vector3d(side * left.x(), side * left.y(), 0.0)};
+      const std::optional<Hit> hit = world.scene().cast(across, 12.0);
+      ++casts;
+      rail_hits += hit && std::abs(hit->distance - 9.5) < 0.2 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(rail_hits, casts);
+}
+
 TEST(Sensors, EachFiresItsBeams) {
   const std::map<std::string, int> beams = {{"hdl64", 64}, {"vlp16", 16}, {"vlp32", 32}, {"os1-64", 64}, {"os1-128", 128}};
   for (const std::string& name : sensorNames()) {

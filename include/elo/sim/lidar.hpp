@@ -25,6 +25,13 @@ struct LidarOptions {
   // true: the whole sweep is taken at its start pose (no motion distortion); false: each firing from
   // the pose at its own time, as a real spinning sensor does while the vehicle moves.
   bool deskewed = true;
+  // Clutter that makes neighbouring pixels of a real scan lie on different surfaces; both are off by
+  // default. foliage_depth: the mean depth (m, exponential, at most three times the mean) that a beam
+  // reaches into leaves before it echoes. mixed_pixel_probability: the chance that a return beside a
+  // depth edge (a jump of more than 0.5 m to the next firing of its beam, not a smooth slope) comes
+  // back from anywhere between the two surfaces, as when the beam's footprint straddles the edge.
+  double foliage_depth = 0.0;
+  double mixed_pixel_probability = 0.0;
   // The car the sensor is mounted on, in the sensor frame: beams that meet it return nothing (its
   // surfaces lie inside min_range). Empty: a sensor floating free.
   std::vector<Shape> vehicle_body = roofMountedCar();
@@ -67,6 +74,10 @@ class Lidar {
   double firingTime(int step) const { return step * sweepDuration() / azimuthSteps(); }
   std::vector<Return> castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const;
   SimulatedScan addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const;
+  // The range of `result` with the clutter of LidarOptions; `previous` and `next` are the firings of its
+  // beam before and after it.
+  double clutteredRange(const Return& previous, const Return& result, const Return& next, Rng& rng) const;
+  static bool atDepthEdge(const Return& previous, const Return& result, const Return& next);
   bool detected(const Return& result, Rng& rng) const;
   bool hitsVehicle(const Eigen::Vector3d& direction) const;
 

@@ -61,6 +61,7 @@ struct Primitive {
   Shape shape;
   float reflectivity;                 // 0..1: the intensity of a return at normal incidence
   std::optional<WindowGrid> windows;  // boxes only
+  bool foliage = false;               // leaves: beams may reach into it before echoing (LidarOptions)
 };
 
 // The reflectivity a beam meets where it hits `point` (with surface `normal`) of the primitive: its

@@ -13,7 +13,7 @@
 
 namespace elo::sim {
 
-enum class SurfaceKind : uint8_t { ground, object, moving_object };
+enum class SurfaceKind : uint8_t { ground, object, moving_object, foliage };
 
 struct Hit {
   double distance = 0.0;

@@ -9,42 +9,54 @@ namespace {
 
 constexpr double kEmbedding = 0.3;        // m a standing block reaches below its lowest corner's ground
 constexpr double kFrontageSpacing = 2.0;  // m between the frontage points that record a furnished lot
-constexpr double kRevisitRadius = 3.0;    // m: a frontage point this close to an earlier one is revisited
+constexpr double kRevisitRadius = 3.0;    // m: a frontage point this close to an earlier one is revisited,
+constexpr double kRevisitArc = 2.0 * kRevisitRadius;  // m: when the road beside them is this far apart
 constexpr double kEdgeSampling = 1.0;     // m between the footprint points checked against the route
 
-// Frontage points of the lots furnished so far, hashed by cell for the revisit test.
+// A point of a lot's frontage line and the road's arc length beside it.
+struct FrontagePoint {
+  Eigen::Vector2d point;
+  double arc;
+};
+
+// Frontage points of the lots furnished so far, hashed by cell for the revisit test. A revisit is the
+// road coming back past a place: an earlier point close by that stands beside another stretch of the
+// road. The lot just before shares its end with this one's start; that is no revisit.
 class FrontageIndex {
  public:
-  bool mostlyRevisited(const std::vector<Eigen::Vector2d>& points) const {
+  bool mostlyRevisited(const std::vector<FrontagePoint>& points) const {
     size_t revisited = 0;
-    for (const Eigen::Vector2d& point : points) revisited += isNear(point) ? 1 : 0;
+    for (const FrontagePoint& point : points) revisited += isRevisit(point) ? 1 : 0;
     return 2 * revisited > points.size();
   }
 
-  void add(const std::vector<Eigen::Vector2d>& points) {
-    for (const Eigen::Vector2d& point : points) cells_[key(cellOf(point.x()), cellOf(point.y()))].push_back(point);
+  void add(const std::vector<FrontagePoint>& points) {
+    for (const FrontagePoint& point : points) {
+      cells_[key(cellOf(point.point.x()), cellOf(point.point.y()))].push_back(point);
+    }
   }
 
  private:
   static int64_t cellOf(double coordinate) { return static_cast<int64_t>(std::floor(coordinate / kRevisitRadius)); }
   static int64_t key(int64_t col, int64_t row) { return col * 0x100000000LL + row; }
 
-  bool isNear(const Eigen::Vector2d& point) const {
-    const int64_t col = cellOf(point.x());
-    const int64_t row = cellOf(point.y());
+  bool isRevisit(const FrontagePoint& point) const {
+    const int64_t col = cellOf(point.point.x());
+    const int64_t row = cellOf(point.point.y());
     for (int64_t dc = -1; dc <= 1; ++dc) {
       for (int64_t dr = -1; dr <= 1; ++dr) {
         const auto cell = cells_.find(key(col + dc, row + dr));
         if (cell == cells_.end()) continue;
-        for (const Eigen::Vector2d& other : cell->second) {
-          if ((other - point).squaredNorm() < kRevisitRadius * kRevisitRadius) return true;
+        for (const FrontagePoint& other : cell->second) {
+          const bool close = (other.point - point.point).squaredNorm() < kRevisitRadius * kRevisitRadius;
+          if (close && std::abs(other.arc - point.arc) > kRevisitArc) return true;
         }
       }
     }
     return false;
   }
 
-  std::unordered_map<int64_t, std::vector<Eigen::Vector2d>> cells_;
+  std::unordered_map<int64_t, std::vector<FrontagePoint>> cells_;
 };
 
 std::vector<Eigen::Vector2d> rectangle(const Eigen::Vector2d& center, double heading, double length, double width) {
@@ -69,9 +81,9 @@ void Roadside::forEachLot(double frontage, const std::function<double(Rng&)>& lo
     for (double begin = 0.0; begin < road_.length(); ++index) {
       const Lot lot{begin, std::max(lot_length(lengths), 0.5), side, index};
       begin += lot.length;
-      std::vector<Eigen::Vector2d> points;
+      std::vector<FrontagePoint> points;
       for (double along = 0.0; along <= lot.length; along += kFrontageSpacing) {
-        points.push_back(place(lot, along, frontage).point);
+        points.push_back({place(lot, along, frontage).point, lot.begin + along});
       }
       if (furnished.mostlyRevisited(points)) continue;
       furnished.add(points);

@@ -10,6 +10,13 @@ constexpr float kFoliageReflectivity = 0.35f;
 constexpr float kBarkReflectivity = 0.25f;
 constexpr double kEmbedding = 0.2;  // m a trunk reaches below the ground, so that slopes leave no gap
 
+// A lobe of leaves: an ellipsoid that beams may reach into before they echo.
+Primitive foliage(const Ellipsoid& lobe) {
+  Primitive leaves(lobe, kFoliageReflectivity);
+  leaves.foliage = true;
+  return leaves;
+}
+
 }  // namespace
 
 CarBody CarBody::random(Rng& rng) {
@@ -61,7 +68,7 @@ void addTree(std::vector<Primitive>& out, const Eigen::Vector2d& position, doubl
                                  rng.uniform(-0.3, 0.4) * crown);
     const Eigen::Vector3d radii(rng.uniform(0.6, 1.0) * crown, rng.uniform(0.6, 1.0) * crown,
                                 rng.uniform(0.5, 0.9) * crown);
-    out.push_back({Ellipsoid{crown_center + offset, radii, rng.uniform(0.0, M_PI)}, kFoliageReflectivity});
+    out.push_back(foliage(Ellipsoid{crown_center + offset, radii, rng.uniform(0.0, M_PI)}));
   }
 }
 
@@ -73,7 +80,7 @@ void addBush(std::vector<Primitive>& out, const Eigen::Vector2d& position, doubl
                                  position.y() + rng.uniform(-0.7, 0.7) * size, ground_z + rng.uniform(0.1, 0.5) * size);
     const Eigen::Vector3d radii(rng.uniform(0.6, 1.0) * size, rng.uniform(0.6, 1.0) * size,
                                 rng.uniform(0.5, 0.9) * size);
-    out.push_back({Ellipsoid{center, radii, rng.uniform(0.0, M_PI)}, kFoliageReflectivity});
+    out.push_back(foliage(Ellipsoid{center, radii, rng.uniform(0.0, M_PI)}));
   }
 }
 
