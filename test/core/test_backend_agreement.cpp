@@ -244,20 +244,33 @@ TEST(BackendAgreement, ModelUpdatesAgree) {
   }
 }
 
+// The odometry in `mode` on each backend, the CPU's with 2 threads.
+struct OdometryOnBothBackends {
+  explicit OdometryOnBothBackends(RegistrationMode mode)
+      : cpu(configFor(mode, BackendKind::cpu)), cuda(configFor(mode, BackendKind::cuda)) {}
+
+  static Config configFor(RegistrationMode mode, BackendKind backend) {
+    Config config;
+    config.model.mode = mode;
+    config.runtime.threads = 2;
+    config.runtime.backend = backend;
+    return config;
+  }
+
+  Odometry cpu;
+  Odometry cuda;
+};
+
 // Drives down the street with turning, accelerating motion in `mode`, on both backends.
 void expectAgreeingStreetDrive(RegistrationMode mode) {
-  Config config;
-  config.model.mode = mode;
-  config.runtime.threads = 2;
-  Odometry cpu(config);
-  config.runtime.backend = BackendKind::cuda;
-  Odometry cuda(config);
+  const Config config;
+  OdometryOnBothBackends odometry(mode);
   Eigen::Isometry3d truth = pose(-20, 0, 0, 0, 0, 0);
   double speed = 8.0;
   for (int frame = 0; frame < 25; ++frame) {
     const PointCloud cloud = streetScan(config, truth, 0.1 * frame, 0.02);
-    const FrameResult a = cpu.process(cloud);
-    const FrameResult b = cuda.process(cloud);
+    const FrameResult a = odometry.cpu.process(cloud);
+    const FrameResult b = odometry.cuda.process(cloud);
     ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
     expectAgreeingPoses(a.pose, b.pose, frame);
     speed += 0.3;
@@ -285,15 +298,10 @@ TEST(BackendAgreement, RealScansAgreeStageByStageAndInPose) {
     expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
   }
   for (const RegistrationMode mode : {RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame}) {
-    Config config;
-    config.model.mode = mode;
-    config.runtime.threads = 2;
-    Odometry cpu(config);
-    config.runtime.backend = BackendKind::cuda;
-    Odometry cuda(config);
+    OdometryOnBothBackends odometry(mode);
     for (size_t i = 0; i < sequence.size(); ++i) {
       const PointCloud cloud = sequence.load(i);
-      expectAgreeingPoses(cpu.process(cloud).pose, cuda.process(cloud).pose, i);
+      expectAgreeingPoses(odometry.cpu.process(cloud).pose, odometry.cuda.process(cloud).pose, i);
     }
   }
 }

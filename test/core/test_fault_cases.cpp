@@ -47,27 +47,29 @@ PointCloud oneRing(const PointCloud& cloud, uint16_t ring) {
 }
 
 // Every `stride`-th point: what a sensor behind a dirty or covered window still returns.
-PointCloud everyNth(const PointCloud& cloud, size_t stride) {
-  PointCloud sparse;
-  sparse.stamp = cloud.stamp;
-  for (size_t i = 0; i < cloud.size(); i += stride) {
-    sparse.points.push_back(cloud.points[i]);
-    sparse.ring.push_back(cloud.ring[i]);
+// The points of `cloud` (and their rings) whose index `keep` accepts.
+template <typename Keep>
+PointCloud keptPoints(const PointCloud& cloud, Keep keep) {
+  PointCloud kept;
+  kept.stamp = cloud.stamp;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (!keep(i)) continue;
+    kept.points.push_back(cloud.points[i]);
+    kept.ring.push_back(cloud.ring[i]);
   }
-  return sparse;
+  return kept;
+}
+
+PointCloud everyNth(const PointCloud& cloud, size_t stride) {
+  return keptPoints(cloud, [stride](size_t i) { return i % stride == 0; });
 }
 
 // The points within `degrees` of straight ahead: a sensor blocked but for a sector.
 PointCloud aheadSector(const PointCloud& cloud, double degrees) {
-  PointCloud sector;
-  sector.stamp = cloud.stamp;
-  for (size_t i = 0; i < cloud.size(); ++i) {
+  return keptPoints(cloud, [&](size_t i) {
     const double azimuth = std::atan2(cloud.points[i].y(), cloud.points[i].x()) * 180.0 / M_PI;
-    if (std::abs(azimuth) > 0.5 * degrees) continue;
-    sector.points.push_back(cloud.points[i]);
-    sector.ring.push_back(cloud.ring[i]);
-  }
-  return sector;
+    return std::abs(azimuth) <= 0.5 * degrees;
+  });
 }
 
 // `copies` copies of every point, each moved by up to a millimetre: a dense cloud of the same scene.
