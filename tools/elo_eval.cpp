@@ -1,4 +1,5 @@
-// elo_eval: KITTI drift, RPE and ATE of estimated trajectories against ground truth.
+// elo_eval: KITTI drift, RPE and ATE of estimated trajectories against ground truth, and the map entropy
+// of a trajectory over its scans where there is no ground truth.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -9,9 +10,11 @@
 #include <vector>
 
 #include "elo/eval/evaluation.hpp"
+#include "elo/eval/map_entropy.hpp"
 #include "elo/eval/plot.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/sequence.hpp"
 #include "command_line.hpp"
 
 namespace fs = std::filesystem;
@@ -22,10 +25,12 @@ constexpr int kExitBadInput = 2;
 
 const char* const kUsage =
     "usage: elo_eval --gt GT --est EST [--plot PNG] [--tum]\n"
+    "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
     "\n"
     "Evaluates estimated trajectories against ground truth with the KITTI odometry metric (t_rel, r_rel over\n"
     "segments of 100..800 m), the relative pose error between consecutive frames and the absolute trajectory\n"
-    "error after a rigid alignment.\n"
+    "error after a rigid alignment. Without ground truth, --map-entropy scores one trajectory by the sharpness\n"
+    "of the map its scans make.\n"
     "\n"
     "  --gt GT      a KITTI pose file (12 numbers a line), or a directory of NN.txt pose files\n"
     "  --est EST    the estimate: a file when GT is a file, a directory when GT is one; every NN.txt present\n"
@@ -34,6 +39,11 @@ const char* const kUsage =
     "               directories, sequence NN goes to PNG with _NN before the extension and the pooled errors\n"
     "               to PNG itself\n"
     "  --tum        the files are TUM trajectories (t x y z qx qy qz qw) instead of KITTI poses\n"
+    "  --map-entropy SCANS\n"
+    "               the scans EST was estimated from (a directory as elo_run reads, one pose per scan): builds\n"
+    "               the map of their points at 3..30 m and prints its mean map entropy (nats, lower is\n"
+    "               sharper) and the mean spread off the local planes within 0.3 m of every 50th map point.\n"
+    "               Holds every other point of every scan in memory (about 40 MB per 60 HDL-64E scans)\n"
     "  --help       this text\n"
     "\n"
     "Exit status: 0 on success, 2 on bad arguments or unreadable or mismatched inputs.\n";
@@ -42,6 +52,7 @@ struct Options {
   std::string ground_truth;
   std::string estimate;
   std::optional<std::string> plot;
+  std::optional<std::string> map_entropy_scans;
   bool tum = false;
 };
 
@@ -59,12 +70,18 @@ Options parseArguments(int argc, char** argv) {
       options.plot = arguments.value();
     } else if (arguments.is("--tum")) {
       options.tum = true;
+    } else if (arguments.is("--map-entropy")) {
+      options.map_entropy_scans = arguments.value();
     } else {
       arguments.rejectFlag();
     }
   }
-  if (options.ground_truth.empty() || options.estimate.empty()) {
-    throw UsageError("both --gt and --est are required");
+  if (options.estimate.empty()) throw UsageError("--est is required");
+  if (options.ground_truth.empty() && !options.map_entropy_scans) {
+    throw UsageError("--gt is required unless --map-entropy is given");
+  }
+  if (options.map_entropy_scans && fs::is_directory(options.estimate)) {
+    throw UsageError("--map-entropy scores one trajectory: --est must be a file");
   }
   return options;
 }
@@ -143,7 +160,31 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
   return evaluation;
 }
 
+// The map entropy of the trajectory in options.estimate over the scans in options.map_entropy_scans.
+void printMapEntropy(const Options& options) {
+  const std::vector<Eigen::Isometry3d> poses = readTrajectory(options.estimate, options.tum);
+  const elo::Sequence scans(*options.map_entropy_scans);
+  if (scans.size() != poses.size()) {
+    throw elo::IoError("'" + options.estimate + "' holds " + std::to_string(poses.size()) + " poses for the " +
+                       std::to_string(scans.size()) + " scans of '" + *options.map_entropy_scans + "'");
+  }
+  const elo::MapEntropyOptions settings;
+  std::vector<Eigen::Vector3f> map;
+  for (size_t i = 0; i < scans.size(); ++i) elo::addScanToMap(scans.load(i).points, poses[i], settings, map);
+  elo::MapEntropy entropy;
+  try {
+    entropy = elo::mapEntropy(map, settings);
+  } catch (const std::invalid_argument& error) {
+    throw elo::IoError("the map of '" + *options.map_entropy_scans + "': " + error.what());
+  }
+  std::printf("map entropy %.4f nats, plane deviation %.2f mm (%zu neighbourhoods of %zu map points)\n",
+              entropy.mean_entropy, 1000.0 * entropy.mean_plane_deviation_m, entropy.scored_points,
+              entropy.map_points);
+}
+
 int run(const Options& options) {
+  if (options.map_entropy_scans) printMapEntropy(options);
+  if (options.ground_truth.empty()) return 0;
   const std::vector<SequenceFiles> sequences = pairSequenceFiles(options);
   const bool directories = fs::is_directory(options.ground_truth);
   std::vector<elo::TrajectoryEvaluation> evaluations;

@@ -161,6 +161,9 @@ std::vector<Parameter> parameters(Config& c) {
                   {RegistrationMode::frame_to_frame, "frame_to_frame"}},
                  "register against the fused model or the previous scan (Sec. III-D)"),
       bindField("model.time_window", m.time_window, "tau_w: model points older than this are dropped, s (Sec. III-D)"),
+      bindField("model.same_surface_distance", m.same_surface_distance,
+                "a closer point wins a model pixel only when closer by more than this, m; within it the oldest "
+                "stays; 0 = the paper's literal closer-wins"),
       bindChoice("model.motion_prior", m.motion_prior,
                  {{MotionPrior::constant_acceleration, "constant_acceleration"},
                   {MotionPrior::constant_velocity, "constant_velocity"},
@@ -234,6 +237,7 @@ void validate(const Config& c) {
           "must lie in [0, 1/3)");
 
   require(c.model.time_window > 0.0, "model.time_window", "must be positive");
+  require(c.model.same_surface_distance >= 0.0, "model.same_surface_distance", "must not be negative");
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
 }
 

@@ -123,5 +123,35 @@ TEST_F(EloEvalCli, UnreadableFilesExitWith2NamingThem) {
   EXPECT_TRUE(contains(broken.output, directory_.file("broken.txt") + ":1")) << broken.output;
 }
 
+// Two scans of a wall 10 m ahead from the same place, in a flat sequence directory. Its points alternate
+// 5 mm in front of and behind the plane x = 10, so that it has a thickness to measure.
+std::string writeWallScans(const test::TempDirectory& directory) {
+  std::filesystem::create_directories(directory.path() / "scans");
+  PointCloud wall;
+  for (int i = 0; i < 300; ++i) {
+    for (int j = 0; j < 100; ++j) wall.points.emplace_back((i + j) % 2 ? 10.005f : 9.995f, -3.0f + 0.02f * i, -1.0f + 0.02f * j);
+  }
+  for (const char* name : {"000000.bin", "000001.bin"}) writeKittiBin(directory.file(std::string("scans/") + name), wall);
+  return directory.file("scans");
+}
+
+TEST_F(EloEvalCli, MapEntropyScoresATrajectoryWithoutGroundTruth) {
+  const std::string scans = writeWallScans(directory_);
+  writeKittiPoses(directory_.file("still.txt"), {Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()});
+  const CommandResult result = runEloEval("--est " + directory_.file("still.txt") + " --map-entropy " + scans);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "map entropy")) << result.output;
+  EXPECT_TRUE(contains(result.output, "plane deviation 5.0")) << result.output;
+}
+
+TEST_F(EloEvalCli, MapEntropyNeedsOnePosePerScan) {
+  const std::string scans = writeWallScans(directory_);
+  writeKittiPoses(directory_.file("three.txt"), std::vector<Eigen::Isometry3d>(3, Eigen::Isometry3d::Identity()));
+  const CommandResult result = runEloEval("--est " + directory_.file("three.txt") + " --map-entropy " + scans);
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_TRUE(contains(result.output, "3 poses for the 2 scans")) << result.output;
+  EXPECT_EQ(runEloEval("--est " + directory_.file("est") + " --map-entropy " + scans).exit_code, 2);
+}
+
 }  // namespace
 }  // namespace elo

@@ -1,12 +1,31 @@
 // Sec. III-D: the rules of the model update that both backends apply per point. The model lives in the
 // frame of the latest scan: each model point moves into the new frame and is offered again to the pixel
-// or cell it projects to, as is each scan point, and the closest offer wins (closest_wins_key.hpp); a
-// pixel no scan point is offered to keeps its model point.
+// or cell it projects to, as is each scan point; a pixel no scan point is offered to keeps its model
+// point.
+//
+// Which offer a spherical pixel keeps takes two rounds of closest-wins keys (closest_wins_key.hpp). The
+// first finds the closest offer. In the second, the offers on the same surface as the closest one (within
+// model.same_surface_distance of its range) compete by age, and the oldest wins. A surface in front
+// thus still replaces what it hides, as the paper's "closer wins" intends, while the noisy ranges of one
+// surface seen again are not filtered for their nearest: which one stays no longer depends on its noise.
 #pragma once
 
+#include "core/common/closest_wins_key.hpp"
+#include "elo/config.hpp"
 #include "elo/device_types.hpp"
 
 namespace elo {
+
+// When and how the spherical model fuses a scan (both backends).
+struct SphericalFusion {
+  float now;                    // the scan's stamp
+  float time_window;            // tau_w
+  float same_surface_distance;  // model.same_surface_distance
+
+  static SphericalFusion fromConfig(const ModelConfig& config, float now) {
+    return {now, static_cast<float>(config.time_window), static_cast<float>(config.same_surface_distance)};
+  }
+};
 
 // Model points observed more than tau_w before `now` are dropped.
 ELO_HOST_DEVICE inline bool isCurrent(float now, float observed, float time_window) { return now - observed <= time_window; }
@@ -19,5 +38,15 @@ ELO_HOST_DEVICE inline bool joinsModel(PixelLabel label, const Float3& normal) {
 // In the spherical fusion, model pixel q offers itself as source q and scan pixel q as source pixels + q.
 ELO_HOST_DEVICE inline uint32_t scanSource(uint32_t pixel, uint32_t pixels) { return pixels + pixel; }
 ELO_HOST_DEVICE inline bool isScanSource(uint32_t source, uint32_t pixels) { return source >= pixels; }
+
+// Whether an offer at `range` takes part in the second round of a pixel whose closest offer is at
+// `closest_range`. The closest offer itself always does.
+ELO_HOST_DEVICE inline bool onClosestSurface(float range, float closest_range, float same_surface_distance) {
+  return range <= closest_range + same_surface_distance;
+}
+
+// The second round's key: the earliest observation wins, equal stamps fall to the lower source. Stamps
+// count from the first scan and are never negative, so their float bits order like the times.
+ELO_HOST_DEVICE inline ClosestKey oldestWinsKey(float stamp, uint32_t source) { return closestWinsKey(stamp, source); }
 
 }  // namespace elo

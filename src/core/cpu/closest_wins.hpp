@@ -22,14 +22,16 @@ class ClosestWins {
     for (size_t i = 0; i < size_; ++i) keys_[i].store(kNoClosestKey, std::memory_order_relaxed);
   }
 
-  void offer(size_t pixel, float range, uint32_t source) {
-    const ClosestKey key = closestWinsKey(range, source);
+  void offer(size_t pixel, float range, uint32_t source) { offerKey(pixel, closestWinsKey(range, source)); }
+  // The smaller key stays.
+  void offerKey(size_t pixel, ClosestKey key) {
     ClosestKey current = keys_[pixel].load(std::memory_order_relaxed);
     while (key < current && !keys_[pixel].compare_exchange_weak(current, key, std::memory_order_relaxed)) {
     }
   }
 
   bool occupied(size_t pixel) const { return keys_[pixel].load(std::memory_order_relaxed) != kNoClosestKey; }
+  float range(size_t pixel) const { return closestWinsRange(keys_[pixel].load(std::memory_order_relaxed)); }
   uint32_t winner(size_t pixel) const { return closestWinsSource(keys_[pixel].load(std::memory_order_relaxed)); }
 
  private:

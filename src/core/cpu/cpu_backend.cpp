@@ -27,6 +27,7 @@ CpuBackend::CpuBackend(const Config& config)
   allocate(model_, spherical_, bev_);
   allocate(fused_, spherical_, bev_);
   winners_.resize(scan_.image.pixelCount());
+  closest_.resize(scan_.image.pixelCount());
 }
 
 size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp) {
@@ -76,8 +77,8 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   }
   const float window = static_cast<float>(config_.model.time_window);
   arena_.execute([&] {
-    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, stamp, window, winners_,
-                       fused_.nonground);
+    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan,
+                       SphericalFusion::fromConfig(config_.model, stamp), closest_, winners_, fused_.nonground);
   });
   fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, stamp, window, fused_.ground);
   std::swap(model_, fused_);

@@ -37,6 +37,7 @@ class CpuBackend final : public Backend {
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_
   ClosestWins winners_;
+  ClosestWins closest_;  // the model update's first round
   NormalScratch normal_scratch_;
   GroundNormalCache ground_normals_;
 };

@@ -1,8 +1,9 @@
 // Sec. III-D: the model update. The model lives in the frame of the latest scan: each frame, every model
 // point moves into the new frame and is re-projected; where the scan also has a point the one closer to
-// the sensor stays, where it has none the model's stays, and points older than tau_w go. Only three 2D
-// maps are kept (vertex and normal maps of the SRI, vertex map of the BEV), so memory never grows. The
-// per-point rules are shared with the CUDA backend (model_update.hpp).
+// the sensor stays, unless both lie on one surface, when the older stays; where it has none the model's
+// stays, and points older than tau_w go. Only three 2D maps are kept (vertex and normal maps of the SRI,
+// vertex map of the BEV), so memory never grows. The per-point rules are shared with the CUDA backend
+// (model_update.hpp).
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/cpu/parallel.hpp"
@@ -11,24 +12,37 @@
 namespace elo::cpu {
 
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, float stamp, float time_window,
+                        const Eigen::Isometry3d& model_from_scan, const SphericalFusion& fusion, ClosestWins& closest,
                         ClosestWins& winners, SphericalImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
   const uint32_t pixels = static_cast<uint32_t>(model.pixelCount());
-
-  winners.reset();
-  parallelFor(pixels, [&](size_t pixel) {
-    if (!model.occupied(pixel) || !model.hasNormal(pixel) || !isCurrent(stamp, model.stamp[pixel], time_window)) return;
-    const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
-    int row = 0;
-    int col = 0;
-    if (!projection.pixelOf(moved, row, col)) return;
-    winners.offer(static_cast<size_t>(row) * projection.cols + col, norm(moved), static_cast<uint32_t>(pixel));
-  });
   const SphericalImage& observed = scan.image;
-  parallelFor(pixels, [&](size_t pixel) {
-    if (!joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) return;
-    winners.offer(pixel, observed.range[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
+  // Calls offer(pixel, range, stamp, source) for every current model point, moved, and every scan point
+  // that joins the model.
+  const auto forEachOffer = [&](const auto& offer) {
+    parallelFor(pixels, [&](size_t pixel) {
+      if (!model.occupied(pixel) || !model.hasNormal(pixel)) return;
+      if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return;
+      const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
+      int row = 0;
+      int col = 0;
+      if (!projection.pixelOf(moved, row, col)) return;
+      const size_t target = static_cast<size_t>(row) * projection.cols + col;
+      offer(target, norm(moved), model.stamp[pixel], static_cast<uint32_t>(pixel));
+    });
+    parallelFor(pixels, [&](size_t pixel) {
+      if (!joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) return;
+      offer(pixel, observed.range[pixel], observed.stamp[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
+    });
+  };
+
+  closest.reset();
+  forEachOffer([&](size_t pixel, float range, float, uint32_t source) { closest.offer(pixel, range, source); });
+  winners.reset();
+  forEachOffer([&](size_t pixel, float range, float observed_at, uint32_t source) {
+    if (onClosestSurface(range, closest.range(pixel), fusion.same_surface_distance)) {
+      winners.offerKey(pixel, oldestWinsKey(observed_at, source));
+    }
   });
 
   parallelFor(pixels, [&](size_t pixel) {

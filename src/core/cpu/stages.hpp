@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
 #include "core/cpu/closest_wins.hpp"
 #include "elo/backend.hpp"
@@ -77,10 +78,11 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
                     GroundNormalCache& normals, const Eigen::Isometry3d& model_from_scan, double kernel_scale,
                     const RegistrationConfig& registration, const BevConfig& bev);
 
-// model_update.cpp: moves the model into the scan's frame and fuses the scan into it, closest point
-// winning, dropping model points older than `time_window`. Results go to `fused`.
+// model_update.cpp: moves the model into the scan's frame and fuses the scan into it: the closest surface
+// wins a pixel and its oldest point stays (model_update.hpp); model points older than the time window go.
+// Results go to `fused`; `closest` and `winners` are scratch for the two rounds.
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, float stamp, float time_window,
+                        const Eigen::Isometry3d& model_from_scan, const SphericalFusion& fusion, ClosestWins& closest,
                         ClosestWins& winners, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused);

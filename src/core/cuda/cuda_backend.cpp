@@ -83,6 +83,7 @@ void CudaBackend::allocate() {
   point_indices_.reserve(pixels_);
   labels_.reserve(pixels_);
   pixel_keys_.reserve(pixels_);
+  closest_keys_.reserve(pixels_);
   registration_flags_.reserve(pixels_);
   registration_offsets_.reserve(pixels_);
   registration_pixels_.reserve(pixels_);
@@ -271,7 +272,8 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
     const float window = static_cast<float>(config_.model.time_window);
     const int next = 1 - current_;
-    cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model, stamp, window,
+    cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model,
+                             SphericalFusion::fromConfig(config_.model, stamp), closest_keys_.data(),
                              pixel_keys_.data(), deviceModel(next), stream);
     cuda::fuseGroundModel(modelGroundMap(current_), modelPoints(), scanGroundMap(), static_cast<int>(pixels_), bev_,
                           scan_from_model, stamp, window, modelGroundMap(next), compaction(), stream);

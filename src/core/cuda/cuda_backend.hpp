@@ -99,6 +99,7 @@ class CudaBackend final : public Backend {
   DeviceArray<int32_t> point_indices_;
   DeviceArray<PixelLabel> labels_;
   DeviceArray<ClosestKey> pixel_keys_;
+  DeviceArray<ClosestKey> closest_keys_;  // the model update's first round
   DeviceArray<int> registration_flags_;
   DeviceArray<int> registration_offsets_;
   DeviceArray<int> registration_pixels_;

@@ -11,6 +11,7 @@
 #include "core/common/association.hpp"
 #include "core/common/closest_wins_key.hpp"
 #include "core/common/ground.hpp"
+#include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
 #include "core/cuda/device_views.hpp"
 
@@ -80,9 +81,10 @@ void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, i
                       Float3* normals, cudaStream_t stream);
 
 // model_update.cu: the non-ground model (Sec. III-D).
+// `closest_keys` and `pixel_keys` are scratch for the two rounds (model_update.hpp).
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
-                        const Rigid3f& scan_from_model, float now, float time_window, ClosestKey* pixel_keys,
-                        const DeviceModelImage& fused, cudaStream_t stream);
+                        const Rigid3f& scan_from_model, const SphericalFusion& fusion, ClosestKey* closest_keys,
+                        ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
 // correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A). JtJ is summed as its upper

@@ -1,7 +1,8 @@
 // Sec. III-D on the GPU, the non-ground model: every current model pixel moves into the scan's frame and
 // offers itself to the pixel it projects to, every scan pixel that joins the model offers itself to its
-// own pixel, and each pixel takes the closest offer (model_update.hpp, the CPU backend's rules). The
-// fused image is written to a second buffer, so no thread reads what another writes.
+// own pixel, and each pixel takes the oldest offer on its closest surface (two rounds of atomicMin, the
+// rules of model_update.hpp that the CPU backend applies too). The fused image is written to a second
+// buffer, so no thread reads what another writes.
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
@@ -10,22 +11,47 @@ namespace elo::cuda {
 
 namespace {
 
-__global__ void offerSphericalSources(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
-                                      Rigid3f scan_from_model, float now, float time_window, ClosestKey* pixel_keys) {
-  const int pixel = globalThread();
-  if (pixel >= model.pixels()) return;
+// The offers of thread `pixel`: its model point, moved, and its scan point, each as (target pixel, range,
+// stamp, source) to `offer`.
+template <typename Offer>
+__device__ void forEachOffer(int pixel, const DeviceModelImage& model, const DeviceScan& scan,
+                             const SphericalProjection& projection, const Rigid3f& scan_from_model,
+                             const SphericalFusion& fusion, Offer offer) {
   const uint32_t pixels = static_cast<uint32_t>(model.pixels());
-  if (model.matchable(pixel) && isCurrent(now, model.stamps[pixel], time_window)) {
+  if (model.matchable(pixel) && isCurrent(fusion.now, model.stamps[pixel], fusion.time_window)) {
     const Float3 moved = scan_from_model.apply(model.vertices[pixel]);
     int row = 0;
     int col = 0;
     if (projection.pixelOf(moved, row, col)) {
-      atomicMin(&pixel_keys[row * projection.cols + col], closestWinsKey(norm(moved), static_cast<uint32_t>(pixel)));
+      offer(row * projection.cols + col, norm(moved), model.stamps[pixel], static_cast<uint32_t>(pixel));
     }
   }
   if (joinsModel(scan.labels[pixel], scan.normals[pixel])) {
-    atomicMin(&pixel_keys[pixel], closestWinsKey(scan.ranges[pixel], scanSource(static_cast<uint32_t>(pixel), pixels)));
+    offer(pixel, scan.ranges[pixel], scan.stamps[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
   }
+}
+
+__global__ void offerClosest(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
+                             Rigid3f scan_from_model, SphericalFusion fusion, ClosestKey* closest_keys) {
+  const int pixel = globalThread();
+  if (pixel >= model.pixels()) return;
+  forEachOffer(pixel, model, scan, projection, scan_from_model, fusion,
+               [&](int target, float range, float, uint32_t source) {
+                 atomicMin(&closest_keys[target], closestWinsKey(range, source));
+               });
+}
+
+__global__ void offerOldestOnClosestSurface(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
+                                            Rigid3f scan_from_model, SphericalFusion fusion,
+                                            const ClosestKey* closest_keys, ClosestKey* pixel_keys) {
+  const int pixel = globalThread();
+  if (pixel >= model.pixels()) return;
+  forEachOffer(pixel, model, scan, projection, scan_from_model, fusion,
+               [&](int target, float range, float observed_at, uint32_t source) {
+                 if (onClosestSurface(range, closestWinsRange(closest_keys[target]), fusion.same_surface_distance)) {
+                   atomicMin(&pixel_keys[target], oldestWinsKey(observed_at, source));
+                 }
+               });
 }
 
 __global__ void takeFusedWinners(const ClosestKey* pixel_keys, DeviceModelImage model, DeviceScan scan,
@@ -68,13 +94,17 @@ __global__ void copyJoiningPixels(DeviceScan scan, DeviceModelImage model) {
 }  // namespace
 
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
-                        const Rigid3f& scan_from_model, float now, float time_window, ClosestKey* pixel_keys,
-                        const DeviceModelImage& fused, cudaStream_t stream) {
+                        const Rigid3f& scan_from_model, const SphericalFusion& fusion, ClosestKey* closest_keys,
+                        ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream) {
   const int pixels = model.pixels();
+  check(cudaMemsetAsync(closest_keys, 0xff, sizeof(ClosestKey) * pixels, stream), "clearing the closest keys");
   check(cudaMemsetAsync(pixel_keys, 0xff, sizeof(ClosestKey) * pixels, stream), "clearing the pixel keys");
-  offerSphericalSources<<<blocksFor(pixels), kThreads, 0, stream>>>(model, scan, projection, scan_from_model, now,
-                                                                    time_window, pixel_keys);
-  checkLaunch("offerSphericalSources");
+  offerClosest<<<blocksFor(pixels), kThreads, 0, stream>>>(model, scan, projection, scan_from_model, fusion,
+                                                           closest_keys);
+  checkLaunch("offerClosest");
+  offerOldestOnClosestSurface<<<blocksFor(pixels), kThreads, 0, stream>>>(model, scan, projection, scan_from_model,
+                                                                          fusion, closest_keys, pixel_keys);
+  checkLaunch("offerOldestOnClosestSurface");
   takeFusedWinners<<<blocksFor(pixels), kThreads, 0, stream>>>(pixel_keys, model, scan, scan_from_model, fused);
   checkLaunch("takeFusedWinners");
 }
