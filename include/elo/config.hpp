@@ -112,11 +112,12 @@ struct RegistrationConfig {
 struct ModelConfig {
   RegistrationMode mode = RegistrationMode::frame_to_model;
   double time_window = 10.0;  // tau_w (s): older model points are dropped
-  // The closer point wins a model pixel only when it is closer by more than this (m): then it is another
-  // surface in front (Sec. III-D). Offers within it are one surface seen again, and the oldest of them
-  // stays. Taken literally, "closer wins" keeps the nearest of every noisy range a pixel is offered, and
-  // pulls the model's surfaces about half the range noise towards the sensor (10 mm at 2 cm noise on the
-  // simulated urban drive), which drifts the registration. 0 is the paper's literal rule.
+  // The closer point wins a pixel of the model, or a cell of a BEV map, only when it is closer by more
+  // than this (m): then it is another surface in front (Sec. III-D). Offers within it are one surface
+  // seen again, and the oldest of them stays (within one scan: the first). Taken literally, "closer
+  // wins" keeps the nearest of the noisy ranges offered and pulls the maps' surfaces towards the sensor
+  // (the non-ground model by 10 mm at 2 cm noise on the simulated urban drive), which drifts the
+  // registration. 0 is the paper's literal rule.
   double same_surface_distance = 0.3;
   MotionPrior motion_prior = MotionPrior::constant_acceleration;
 };

@@ -162,8 +162,8 @@ std::vector<Parameter> parameters(Config& c) {
                  "register against the fused model or the previous scan (Sec. III-D)"),
       bindField("model.time_window", m.time_window, "tau_w: model points older than this are dropped, s (Sec. III-D)"),
       bindField("model.same_surface_distance", m.same_surface_distance,
-                "a closer point wins a model pixel only when closer by more than this, m; within it the oldest "
-                "stays; 0 = the paper's literal closer-wins"),
+                "a closer point wins a model pixel or BEV cell only when closer by more than this, m; within it "
+                "the oldest stays; 0 = the paper's literal closer-wins"),
       bindChoice("model.motion_prior", m.motion_prior,
                  {{MotionPrior::constant_acceleration, "constant_acceleration"},
                   {MotionPrior::constant_velocity, "constant_velocity"},

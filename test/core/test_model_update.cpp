@@ -1,4 +1,5 @@
-// The model update of Sec. III-D: closer point wins, empty pixels keep the model, old points expire.
+// The model update of Sec. III-D: the closer surface wins and keeps its oldest point, empty pixels keep the
+// model, old points expire.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -35,7 +36,7 @@ struct Fixture {
   }
   // Fuses `scan` into `model` at time `now`, leaving the result in `fused`.
   void fuse(const Eigen::Isometry3d& model_from_scan, float now) {
-    const auto fusion = SphericalFusion::fromConfig(config.model, now);
+    const auto fusion = ModelFusion::fromConfig(config.model, now);
     cpu::fuseSphericalModel(model, scan, spherical, model_from_scan, fusion, closest, winners, fused);
   }
   static void put(SphericalImage& image, size_t pixel, const Vec3f& p, float stamp) {
@@ -143,7 +144,7 @@ TEST(ModelUpdate, ModelPointsMoveIntoTheNewFrameAndExpire) {
   EXPECT_EQ(fused.countOccupied(), 1u) << "the point observed 10.5 s ago must have expired";
 }
 
-TEST(ModelUpdate, GroundMapKeepsTheCloserPointAndExpiresOldOnes) {
+TEST(ModelUpdate, GroundMapKeepsTheOldestPointOfTheRoadAndExpiresOldOnes) {
   Fixture f;
   BevImage model;
   model.resize(f.bev.rows, f.bev.cols);
@@ -161,20 +162,45 @@ TEST(ModelUpdate, GroundMapKeepsTheCloserPointAndExpiresOldOnes) {
   const Vec3f old(-7.0f, 1.0f, -1.73f);
   model.keepCloser(cell_of(kept), kept, 4.0f);
   model.keepCloser(cell_of(old), old, 0.0f);
-  const Vec3f observed(10.08f, 3.01f, -1.74f);  // same cell, a little farther from the sensor
-  scan_ground.keepCloser(cell_of(observed), observed, 12.0f);
-  const Vec3f closer(10.01f, 3.02f, -1.72f);  // and a closer one arriving later wins within the scan
+  const Vec3f closer(10.01f, 3.02f, -1.72f);  // the same road in the same cell, a little nearer the sensor
   scan_ground.keepCloser(cell_of(closer), closer, 12.0f);
-  ASSERT_EQ(scan_ground.size(), 1u);
-  EXPECT_TRUE(scan_ground.vertex[0].isApprox(closer));
 
-  cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(), 12.0f, 10.0f, fused);
+  const auto fuseAt12 = [&] {
+    cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
+                         ModelFusion::fromConfig(f.config.model, 12.0f), fused);
+  };
+  fuseAt12();
   ASSERT_EQ(fused.size(), 1u) << "the point observed 12 s ago must have expired";
   const int32_t point = fused.point_of_cell[cell_of(kept)];
   ASSERT_GE(point, 0);
-  EXPECT_TRUE(fused.vertex[point].isApprox(closer));
-  EXPECT_FLOAT_EQ(fused.stamp[point], 12.0f);
+  EXPECT_TRUE(fused.vertex[point].isApprox(kept));
+  EXPECT_FLOAT_EQ(fused.stamp[point], 4.0f);
   EXPECT_FALSE(fused.occupied(cell_of(old)));
+
+  f.config.model.same_surface_distance = 0.0;  // the paper's literal rule: the closer always wins
+  fuseAt12();
+  EXPECT_TRUE(fused.vertex[fused.point_of_cell[cell_of(kept)]].isApprox(closer));
+}
+
+// Within one scan every point has the same age: of the points of one surface in a cell the lower source
+// (pixel) stays, whatever its noise; the literal rule keeps the nearest.
+TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
+  Fixture f;
+  BevImage map;
+  map.resize(f.bev.rows, f.bev.cols);
+  const Vec3f farther(10.05f, 3.04f, -1.75f);
+  const Vec3f nearer(10.01f, 3.01f, -1.72f);
+  int row = 0;
+  int col = 0;
+  ASSERT_TRUE(f.bev.cellOf(farther, row, col));
+  const int32_t cell = row * f.bev.cols + col;
+  const std::vector<cpu::GroundOffer> offers = {{cell, nearer, 1.0f, 9}, {cell, farther, 1.0f, 7}};
+  cpu::fillGroundMap(offers, 0.3f, map);
+  ASSERT_EQ(map.size(), 1u);
+  EXPECT_EQ(map.vertex[0], farther);
+  EXPECT_FLOAT_EQ(map.range[0], farther.norm());
+  cpu::fillGroundMap(offers, 0.0f, map);
+  EXPECT_EQ(map.vertex[0], nearer);
 }
 
 TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
@@ -196,7 +222,7 @@ TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
       ASSERT_TRUE(f.bev.cellOf(p, row, col));
       scan_ground.keepCloser(row * f.bev.cols + col, p, 0.1f * frame);
     }
-    cpu::fuseGroundModel(model, scan_ground, f.bev, step, 0.1f * frame, 10.0f, fused);
+    cpu::fuseGroundModel(model, scan_ground, f.bev, step, ModelFusion::fromConfig(f.config.model, 0.1f * frame), fused);
     std::swap(model, fused);
   }
   // A point seen at x = 0 one frame ago now lies at x = -1.

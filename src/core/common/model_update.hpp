@@ -3,9 +3,10 @@
 // or cell it projects to, as is each scan point; a pixel no scan point is offered to keeps its model
 // point.
 //
-// Which offer a spherical pixel keeps takes two rounds of closest-wins keys (closest_wins_key.hpp). The
+// Which offer a pixel or cell keeps takes two rounds of closest-wins keys (closest_wins_key.hpp). The
 // first finds the closest offer. In the second, the offers on the same surface as the closest one (within
-// model.same_surface_distance of its range) compete by age, and the oldest wins. A surface in front
+// model.same_surface_distance of its range) compete by age, and the oldest wins; equal ages, as the
+// points of one scan have, fall to the lower source. A surface in front
 // thus still replaces what it hides, as the paper's "closer wins" intends, while the noisy ranges of one
 // surface seen again are not filtered for their nearest: which one stays no longer depends on its noise.
 #pragma once
@@ -16,13 +17,13 @@
 
 namespace elo {
 
-// When and how the spherical model fuses a scan (both backends).
-struct SphericalFusion {
+// When and how the model fuses a scan (both backends).
+struct ModelFusion {
   float now;                    // the scan's stamp
   float time_window;            // tau_w
   float same_surface_distance;  // model.same_surface_distance
 
-  static SphericalFusion fromConfig(const ModelConfig& config, float now) {
+  static ModelFusion fromConfig(const ModelConfig& config, float now) {
     return {now, static_cast<float>(config.time_window), static_cast<float>(config.same_surface_distance)};
   }
 };

@@ -2,20 +2,44 @@
 // the model points nearest an associated cell (groundNormal() of association.hpp, shared with the CUDA
 // backend).
 #include "core/common/association.hpp"
+#include "core/common/eigen_interop.hpp"
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
 
-void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground) {
-  ground.clear();
+void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
+                    BevImage& ground) {
   const SphericalImage& image = scan.image;
+  std::vector<GroundOffer> offers;
   for (size_t pixel = 0; pixel < image.pixelCount(); ++pixel) {
     if (scan.label[pixel] != PixelLabel::ground) continue;
     int row = 0;
     int col = 0;
     if (!projection.cellOf(image.vertex[pixel], row, col)) continue;
-    ground.keepCloser(row * projection.cols + col, image.vertex[pixel], image.stamp[pixel]);
+    offers.push_back({row * projection.cols + col, image.vertex[pixel], image.stamp[pixel], static_cast<uint32_t>(pixel)});
+  }
+  fillGroundMap(offers, same_surface_distance, ground);
+}
+
+void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map) {
+  map.clear();
+  for (const GroundOffer& offer : offers) map.keepCloser(offer.cell, offer.vertex, offer.stamp);
+  std::vector<ClosestKey> oldest(map.size(), kNoClosestKey);
+  std::vector<const GroundOffer*> winners(map.size(), nullptr);
+  for (const GroundOffer& offer : offers) {
+    const int32_t slot = map.point_of_cell[offer.cell];
+    if (!onClosestSurface(norm(toFloat3(offer.vertex)), map.range[slot], same_surface_distance)) continue;
+    const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
+    if (key < oldest[slot]) {
+      oldest[slot] = key;
+      winners[slot] = &offer;
+    }
+  }
+  for (size_t slot = 0; slot < map.size(); ++slot) {
+    map.vertex[slot] = winners[slot]->vertex;
+    map.range[slot] = norm(toFloat3(winners[slot]->vertex));
+    map.stamp[slot] = winners[slot]->stamp;
   }
 }
 

@@ -51,7 +51,9 @@ void CpuBackend::estimateNormals() {
   registration_pixels_ = registrationPixels(scan_);
 }
 
-void CpuBackend::buildGroundMap() { cpu::buildGroundMap(scan_, bev_, scan_ground_); }
+void CpuBackend::buildGroundMap() {
+  cpu::buildGroundMap(scan_, bev_, static_cast<float>(config_.model.same_surface_distance), scan_ground_);
+}
 
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
   NormalEquations sums;
@@ -75,12 +77,12 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
     ground_normals_.reset(model_.ground.size());
     return;
   }
-  const float window = static_cast<float>(config_.model.time_window);
+  const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
   arena_.execute([&] {
-    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan,
-                       SphericalFusion::fromConfig(config_.model, stamp), closest_, winners_, fused_.nonground);
+    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, closest_, winners_,
+                       fused_.nonground);
   });
-  fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, stamp, window, fused_.ground);
+  fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_.ground);
   std::swap(model_, fused_);
   model_.initialized = true;
   ground_normals_.reset(model_.ground.size());

@@ -12,7 +12,7 @@
 namespace elo::cpu {
 
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, const SphericalFusion& fusion, ClosestWins& closest,
+                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, ClosestWins& closest,
                         ClosestWins& winners, SphericalImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
   const uint32_t pixels = static_cast<uint32_t>(model.pixelCount());
@@ -69,20 +69,24 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 }
 
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
-                     const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused) {
+                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
-  fused.clear();
+  std::vector<GroundOffer> offers;
+  offers.reserve(model.size() + scan_ground.size());
   for (size_t point = 0; point < model.size(); ++point) {
-    if (!isCurrent(stamp, model.stamp[point], time_window)) continue;
+    if (!isCurrent(fusion.now, model.stamp[point], fusion.time_window)) continue;
     const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[point]));
     int row = 0;
     int col = 0;
     if (!projection.cellOf(moved, row, col)) continue;
-    fused.keepCloser(row * projection.cols + col, toVec3f(moved), model.stamp[point]);
+    offers.push_back({row * projection.cols + col, toVec3f(moved), model.stamp[point], static_cast<uint32_t>(point)});
   }
+  const uint32_t model_points = static_cast<uint32_t>(model.size());
   for (size_t point = 0; point < scan_ground.size(); ++point) {
-    fused.keepCloser(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point]);
+    offers.push_back({scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
+                      model_points + static_cast<uint32_t>(point)});
   }
+  fillGroundMap(offers, fusion.same_surface_distance, fused);
 }
 
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model) {

@@ -48,7 +48,18 @@ void estimateNormals(const NormalConfig& config, const SphericalProjection& proj
                      ScanImage& scan);
 
 // bev_map.cpp: the BEV map of the ground pixels, closest point per cell.
-void buildGroundMap(const ScanImage& scan, const BevProjection& projection, BevImage& ground);
+void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
+                    BevImage& ground);
+// A point offered to a cell of a ground map by source `source` (the numbering the CUDA backend uses).
+struct GroundOffer {
+  int32_t cell;
+  Vec3f vertex;
+  float stamp;
+  uint32_t source;
+};
+// Fills `map` with `offers` by the two rounds of model_update.hpp: each cell keeps the oldest offer on its
+// closest surface. Slots follow the first offer to each cell.
+void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map);
 
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
 // (Sec. III-C.2, groundNormal() of association.hpp) and kept until the model changes. Safe to query from
@@ -82,10 +93,10 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
 // wins a pixel and its oldest point stays (model_update.hpp); model points older than the time window go.
 // Results go to `fused`; `closest` and `winners` are scratch for the two rounds.
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, const SphericalFusion& fusion, ClosestWins& closest,
+                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, ClosestWins& closest,
                         ClosestWins& winners, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
-                     const Eigen::Isometry3d& model_from_scan, float stamp, float time_window, BevImage& fused);
+                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused);
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
 

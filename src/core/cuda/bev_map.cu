@@ -1,11 +1,11 @@
-// Sec. III-C.2 and III-D on the GPU: BEV maps that keep the point closest to the sensor in each cell, and
-// the normals of the BEV model.
+// Sec. III-C.2 and III-D on the GPU: BEV maps that keep in each cell the oldest point on the surface
+// closest to the sensor (the two rounds of model_update.hpp), and the normals of the BEV model.
 //
 // Order of the compact points. The CPU backend inserts sources one at a time (BevImage::keepCloser()): a
 // cell's point takes the next slot when the cell is first offered a point, and a closer point arriving
 // later overwrites that slot's values. Here every source offers itself to its cell twice at once, with an
-// atomicMin of its closest-wins key (which point stays) and of its source index (which source arrived
-// first). The first arrivals, prefix-summed in source order, give the slots, so both backends' maps agree
+// atomicMin of its closest-wins key (the first round of which point stays) and of its source index (which
+// source arrived first). The first arrivals, prefix-summed in source order, give the slots, so both backends' maps agree
 // element by element, in the same order.
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
@@ -64,8 +64,8 @@ __global__ void offerGroundPixels(DeviceScan scan, BevProjection projection, Cel
 }
 
 // Sources beyond the model's points are scan slots; those past the scan's point count offer nothing.
-__global__ void offerFusionSources(FusionSources sources, int source_count, BevProjection projection, float now,
-                                   float time_window, CellCompaction compaction) {
+__global__ void offerFusionSources(FusionSources sources, int source_count, BevProjection projection, ModelFusion fusion,
+                                   CellCompaction compaction) {
   const int source = globalThread();
   if (source >= source_count) return;
   int cell = -1;
@@ -74,7 +74,7 @@ __global__ void offerFusionSources(FusionSources sources, int source_count, BevP
     int row = 0;
     int col = 0;
     const Float3 moved = sources.scan_from_model.apply(sources.model.vertices[source]);
-    if (isCurrent(now, sources.model.stamps[source], time_window) && projection.cellOf(moved, row, col)) {
+    if (isCurrent(fusion.now, sources.model.stamps[source], fusion.time_window) && projection.cellOf(moved, row, col)) {
       cell = row * projection.cols + col;
       range = norm(moved);
     }
@@ -86,6 +86,22 @@ __global__ void offerFusionSources(FusionSources sources, int source_count, BevP
     }
   }
   offer(compaction, source, cell, range);
+}
+
+// The second round: a source on its cell's closest surface offers its age. Its range is computed as its
+// first offer computed it.
+template <typename Sources>
+__global__ void offerOldestOnClosestSurface(Sources sources, int source_count, float same_surface_distance,
+                                            CellCompaction compaction) {
+  const int source = globalThread();
+  if (source >= source_count) return;
+  const int cell = compaction.source_cells[source];
+  if (cell < 0) return;
+  const float range = norm(sources.vertex(static_cast<uint32_t>(source)));
+  if (onClosestSurface(range, closestWinsRange(compaction.cell_keys[cell]), same_surface_distance)) {
+    atomicMin(&compaction.surface_keys[cell], oldestWinsKey(sources.stamp(static_cast<uint32_t>(source)),
+                                                           static_cast<uint32_t>(source)));
+  }
 }
 
 __global__ void flagFirstArrivals(int source_count, CellCompaction compaction) {
@@ -104,15 +120,16 @@ __global__ void writeWinners(Sources sources, int source_count, CellCompaction c
   if (source == source_count - 1) *map.count = compaction.offsets[source] + compaction.first_flags[source];
   if (compaction.first_flags[source] == 0) return;
   const int cell = compaction.source_cells[source];
-  const ClosestKey key = compaction.cell_keys[cell];
-  const uint32_t winner = closestWinsSource(key);
+  const uint32_t winner = closestWinsSource(compaction.surface_keys[cell]);
   const int slot = compaction.offsets[source];
+  const Float3 vertex = sources.vertex(winner);
   map.cells[slot] = cell;
-  map.vertices[slot] = sources.vertex(winner);
-  map.ranges[slot] = closestWinsRange(key);
+  map.vertices[slot] = vertex;
+  map.ranges[slot] = norm(vertex);
   map.stamps[slot] = sources.stamp(winner);
   map.point_of_cell[cell] = slot;
   compaction.cell_keys[cell] = kNoClosestKey;
+  compaction.surface_keys[cell] = kNoClosestKey;
   compaction.first_sources[cell] = kNoSource;
 }
 
@@ -147,10 +164,14 @@ void clearCellsOf(const DeviceBev& map, cudaStream_t stream) {
   checkLaunch("clearCells");
 }
 
-// Flags the first arrivals of the offers made, sums them into slots and writes the winners into `map`.
+// Runs the second round over the offers made, flags their first arrivals, sums them into slots and writes
+// the winners into `map`.
 template <typename Sources>
-void compactWinners(const Sources& sources, int source_count, const CellCompaction& compaction, const DeviceBev& map,
-                    cudaStream_t stream) {
+void compactWinners(const Sources& sources, int source_count, float same_surface_distance,
+                    const CellCompaction& compaction, const DeviceBev& map, cudaStream_t stream) {
+  offerOldestOnClosestSurface<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count,
+                                                                                same_surface_distance, compaction);
+  checkLaunch("offerOldestOnClosestSurface");
   flagFirstArrivals<<<blocksFor(source_count), kThreads, 0, stream>>>(source_count, compaction);
   checkLaunch("flagFirstArrivals");
   exclusiveSum(compaction.first_flags, compaction.offsets, source_count, compaction.scan_scratch,
@@ -161,25 +182,25 @@ void compactWinners(const Sources& sources, int source_count, const CellCompacti
 
 }  // namespace
 
-void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, const DeviceBev& ground,
-                    const CellCompaction& compaction, cudaStream_t stream) {
+void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
+                    const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream) {
   const int pixels = scan.pixels();
   clearCellsOf(ground, stream);
   offerGroundPixels<<<blocksFor(pixels), kThreads, 0, stream>>>(scan, projection, compaction);
   checkLaunch("offerGroundPixels");
-  compactWinners(PixelSources{scan.vertices, scan.stamps}, pixels, compaction, ground, stream);
+  compactWinners(PixelSources{scan.vertices, scan.stamps}, pixels, same_surface_distance, compaction, ground, stream);
 }
 
 void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
-                     const BevProjection& projection, const Rigid3f& scan_from_model, float now, float time_window,
+                     const BevProjection& projection, const Rigid3f& scan_from_model, const ModelFusion& fusion,
                      const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream) {
   const FusionSources sources{model, model_points, scan_ground, scan_from_model};
   const int source_count = model_points + scan_slots;
   clearCellsOf(fused, stream);
-  offerFusionSources<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count, projection, now,
-                                                                       time_window, compaction);
+  offerFusionSources<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count, projection, fusion,
+                                                                       compaction);
   checkLaunch("offerFusionSources");
-  compactWinners(sources, source_count, compaction, fused, stream);
+  compactWinners(sources, source_count, fusion.same_surface_distance, compaction, fused, stream);
 }
 
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream) {

@@ -96,6 +96,7 @@ void CudaBackend::allocate() {
   // A fusion's sources are the model's points (at most one per cell) and the scan's (at most one per pixel).
   const size_t sources = cells_ + pixels_;
   cell_keys_.reserve(cells_);
+  surface_keys_.reserve(cells_);
   first_sources_.reserve(cells_);
   source_cells_.reserve(sources);
   first_flags_.reserve(sources);
@@ -124,6 +125,7 @@ void CudaBackend::clearDevice() {
     clear(map->point_of_cell, cells_, 0xff, stream);
   }
   clear(cell_keys_, cells_, 0xff, stream);
+  clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
   for (int count = 0; count < kCounts; ++count) host_counts_[count] = 0;
@@ -163,7 +165,7 @@ DeviceBev CudaBackend::deviceBev(const BevBuffers& buffers, int count) const {
 }
 
 CellCompaction CudaBackend::compaction() const {
-  return {cell_keys_.data(),      first_sources_.data(), source_cells_.data(),  first_flags_.data(),
+  return {cell_keys_.data(),      surface_keys_.data(), first_sources_.data(), source_cells_.data(),  first_flags_.data(),
           source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
 }
 
@@ -230,7 +232,8 @@ void CudaBackend::estimateNormals() {
 }
 
 void CudaBackend::buildGroundMap() {
-  cuda::buildGroundMap(deviceScan(), bev_, scanGroundMap(), compaction(), stream_.get());
+  cuda::buildGroundMap(deviceScan(), bev_, static_cast<float>(config_.model.same_surface_distance), scanGroundMap(),
+                       compaction(), stream_.get());
   scan_ground_view_current_ = false;
 }
 
@@ -270,13 +273,12 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     cuda::copyGroundMap(scanGroundMap(), modelGroundMap(current_), stream);
   } else {
     const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
-    const float window = static_cast<float>(config_.model.time_window);
+    const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
     const int next = 1 - current_;
-    cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model,
-                             SphericalFusion::fromConfig(config_.model, stamp), closest_keys_.data(),
-                             pixel_keys_.data(), deviceModel(next), stream);
+    cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model, fusion,
+                             closest_keys_.data(), pixel_keys_.data(), deviceModel(next), stream);
     cuda::fuseGroundModel(modelGroundMap(current_), modelPoints(), scanGroundMap(), static_cast<int>(pixels_), bev_,
-                          scan_from_model, stamp, window, modelGroundMap(next), compaction(), stream);
+                          scan_from_model, fusion, modelGroundMap(next), compaction(), stream);
     current_ = next;
   }
   model_initialized_ = true;

@@ -115,6 +115,7 @@ class CudaBackend final : public Backend {
 
   // Scratch of the BEV compaction (sources: every model point and every scan pixel).
   DeviceArray<ClosestKey> cell_keys_;
+  DeviceArray<ClosestKey> surface_keys_;
   DeviceArray<uint32_t> first_sources_;
   DeviceArray<int> source_cells_;
   DeviceArray<int> first_flags_;

@@ -23,7 +23,8 @@ constexpr uint32_t kNoSource = ~uint32_t{0};  // all bytes 0xff
 // closest-wins key and the lowest source offered to it, both back to "none" after each use. Per source:
 // its cell (-1: none), whether it arrived first in that cell, and the exclusive sum of those flags.
 struct CellCompaction {
-  ClosestKey* cell_keys;
+  ClosestKey* cell_keys;     // first round: the closest offer per cell
+  ClosestKey* surface_keys;  // second round: the oldest offer on its closest surface (model_update.hpp)
   uint32_t* first_sources;
   int* source_cells;
   int* first_flags;
@@ -66,13 +67,13 @@ void labelAllNonground(const DeviceScan& scan, cudaStream_t stream);
 void estimateNormals(const DeviceScan& scan, const NormalParams& params, const FlaggedList& registration_pixels,
                      cudaStream_t stream);
 
-// bev_map.cu: BEV maps (Sec. III-C.2, III-D). Each keeps the closest point per cell, its points in the
-// order the CPU backend inserts them (see bev_map.cu).
-void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, const DeviceBev& ground,
-                    const CellCompaction& compaction, cudaStream_t stream);
+// bev_map.cu: BEV maps (Sec. III-C.2, III-D). Each cell keeps the oldest point on its closest surface
+// (model_update.hpp), the points in the order the CPU backend inserts them (see bev_map.cu).
+void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
+                    const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream);
 // `model_points`: the model's point count; `scan_slots`: a bound on the scan's (its pixel count).
 void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
-                     const BevProjection& projection, const Rigid3f& scan_from_model, float now, float time_window,
+                     const BevProjection& projection, const Rigid3f& scan_from_model, const ModelFusion& fusion,
                      const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream);
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream);
 void clearGroundMap(const DeviceBev& map, cudaStream_t stream);
@@ -83,7 +84,7 @@ void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, i
 // model_update.cu: the non-ground model (Sec. III-D).
 // `closest_keys` and `pixel_keys` are scratch for the two rounds (model_update.hpp).
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
-                        const Rigid3f& scan_from_model, const SphericalFusion& fusion, ClosestKey* closest_keys,
+                        const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
                         ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 

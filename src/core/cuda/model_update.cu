@@ -16,7 +16,7 @@ namespace {
 template <typename Offer>
 __device__ void forEachOffer(int pixel, const DeviceModelImage& model, const DeviceScan& scan,
                              const SphericalProjection& projection, const Rigid3f& scan_from_model,
-                             const SphericalFusion& fusion, Offer offer) {
+                             const ModelFusion& fusion, Offer offer) {
   const uint32_t pixels = static_cast<uint32_t>(model.pixels());
   if (model.matchable(pixel) && isCurrent(fusion.now, model.stamps[pixel], fusion.time_window)) {
     const Float3 moved = scan_from_model.apply(model.vertices[pixel]);
@@ -32,7 +32,7 @@ __device__ void forEachOffer(int pixel, const DeviceModelImage& model, const Dev
 }
 
 __global__ void offerClosest(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
-                             Rigid3f scan_from_model, SphericalFusion fusion, ClosestKey* closest_keys) {
+                             Rigid3f scan_from_model, ModelFusion fusion, ClosestKey* closest_keys) {
   const int pixel = globalThread();
   if (pixel >= model.pixels()) return;
   forEachOffer(pixel, model, scan, projection, scan_from_model, fusion,
@@ -42,7 +42,7 @@ __global__ void offerClosest(DeviceModelImage model, DeviceScan scan, SphericalP
 }
 
 __global__ void offerOldestOnClosestSurface(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
-                                            Rigid3f scan_from_model, SphericalFusion fusion,
+                                            Rigid3f scan_from_model, ModelFusion fusion,
                                             const ClosestKey* closest_keys, ClosestKey* pixel_keys) {
   const int pixel = globalThread();
   if (pixel >= model.pixels()) return;
@@ -94,7 +94,7 @@ __global__ void copyJoiningPixels(DeviceScan scan, DeviceModelImage model) {
 }  // namespace
 
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
-                        const Rigid3f& scan_from_model, const SphericalFusion& fusion, ClosestKey* closest_keys,
+                        const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
                         ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream) {
   const int pixels = model.pixels();
   check(cudaMemsetAsync(closest_keys, 0xff, sizeof(ClosestKey) * pixels, stream), "clearing the closest keys");
