@@ -47,7 +47,8 @@ struct NormalScratch {
 void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, NormalScratch& scratch,
                      ScanImage& scan);
 
-// bev_map.cpp: the BEV map of the ground pixels, closest point per cell.
+// bev_map.cpp: the BEV map of the ground pixels: per cell, the first pixel on the closest surface
+// (fillGroundMap below).
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
                     BevImage& ground);
 // A point offered to a cell of a ground map by source `source` (the numbering the CUDA backend uses).
