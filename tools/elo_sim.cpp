@@ -52,7 +52,8 @@ std::string usage() {
          "                       (x y z intensity ring time, frame velodyne), ground truth on\n"
          "                       /ground_truth and /tf (as kitti_to_bag --poses-frame lidar)\n"
          "  --sensor NAME        " + joined(elo::sim::sensorNames()) + " (default hdl64)\n"
-         "  --seed S             world, noise and dropout seed (default 1): same seed, same scans\n"
+         "  --seed S             seed of the world, the noise and the unit's calibration errors (default 1):\n"
+         "                       same seed, same scans\n"
          "  --config FILE        YAML parameters applied over the sensor's (e.g. sensor.max_range)\n"
          "  --noise M            range noise standard deviation in metres (default: the sensor's, 0.02)\n"
          "  --dropout P          probability that a return is lost (default 0.01)\n"
@@ -63,6 +64,11 @@ std::string usage() {
          "                       (default 0: solid crowns)\n"
          "  --mixed-pixels P     chance that a return at a depth edge comes from between the two\n"
          "                       surfaces (default 0)\n"
+         "  --beam-range-bias M  standard deviation in metres of each laser's constant range offset\n"
+         "                       (default 0: a perfectly calibrated unit)\n"
+         "  --beam-elevation-error DEG\n"
+         "                       standard deviation in degrees of each laser's constant elevation error\n"
+         "                       (default 0); points are still reported along the nominal elevations\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -86,7 +92,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
-      "--mixed-pixels", "--threads"};
+      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -174,6 +180,14 @@ Options parseOptions(int argc, char** argv) {
     if (spec.lidar.mixed_pixel_probability < 0.0 || spec.lidar.mixed_pixel_probability > 1.0) {
       throw UsageError("--mixed-pixels must lie in [0, 1]");
     }
+  }
+  if (const auto bias = take("--beam-range-bias")) {
+    spec.lidar.beam_range_bias = elo::tools::parseNumber<double>("--beam-range-bias", *bias);
+    if (spec.lidar.beam_range_bias < 0.0) throw UsageError("--beam-range-bias must not be negative");
+  }
+  if (const auto error = take("--beam-elevation-error")) {
+    spec.lidar.beam_elevation_error = elo::tools::parseNumber<double>("--beam-elevation-error", *error);
+    if (spec.lidar.beam_elevation_error < 0.0) throw UsageError("--beam-elevation-error must not be negative");
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;

@@ -23,7 +23,8 @@ std::vector<Shape> LidarOptions::roofMountedCar() {
   return {cabin, body};
 }
 
-Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options) : sensor_(sensor), options_(options) {
+Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed)
+    : sensor_(sensor), options_(options) {
   if (sensor.azimuth_steps <= 0 || sensor.rotation_rate_hz <= 0.0 || sensor.max_range <= sensor.min_range) {
     throw std::invalid_argument("sensor '" + sensor.name + "': azimuth_steps, rotation_rate_hz and the range "
                                 "limits must describe a working sensor");
@@ -36,10 +37,11 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options) : sensor_(
   if (options.mixed_pixel_probability < 0.0 || options.mixed_pixel_probability > 1.0) {
     throw std::invalid_argument("mixed pixel probability must lie in [0, 1]");
   }
-  for (const float elevation : beamElevations(sensor)) {
-    beam_directions_.emplace_back(std::cos(static_cast<double>(elevation)), std::sin(static_cast<double>(elevation)));
+  if (options.beam_range_bias < 0.0 || options.beam_elevation_error < 0.0) {
+    throw std::invalid_argument("beam calibration errors must not be negative");
   }
-  if (beam_directions_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");
+  beams_ = drawBeams(sensor, options, unit_seed);
+  if (beams_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");
   // The head turns clockwise seen from above (as Velodyne and Ouster sensors do), starting behind
   // the vehicle: azimuth pi - 2 pi k / N, so that time grows with the range image's column.
   for (int step = 0; step < sensor.azimuth_steps; ++step) {
@@ -48,13 +50,44 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options) : sensor_(
     azimuth_sin_.push_back(std::sin(azimuth));
   }
   for (int step = 0; step < sensor.azimuth_steps; ++step) {
-    for (int beam = 0; beam < beamCount(); ++beam) hidden_by_vehicle_.push_back(hitsVehicle(direction(beam, step)));
+    for (int beam = 0; beam < beamCount(); ++beam) {
+      hidden_by_vehicle_.push_back(hitsVehicle(actualDirection(beam, step)));
+    }
   }
 }
 
+std::vector<Lidar::Beam> Lidar::drawBeams(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed) {
+  // Drawn only when asked for, so that a perfectly calibrated sensor fires exactly along its table.
+  const bool miscalibrated = options.beam_range_bias > 0.0 || options.beam_elevation_error > 0.0;
+  Rng rng(unit_seed);
+  std::vector<Beam> beams;
+  for (const float table_elevation : beamElevations(sensor)) {
+    const double nominal = table_elevation;
+    Beam beam;
+    beam.nominal = Eigen::Vector2d(std::cos(nominal), std::sin(nominal));
+    double actual = nominal;
+    if (miscalibrated) {
+      beam.range_offset = rng.gaussian(0.0, options.beam_range_bias);
+      actual += rng.gaussian(0.0, options.beam_elevation_error * M_PI / 180.0);
+    }
+    beam.actual = Eigen::Vector2d(std::cos(actual), std::sin(actual));
+    beams.push_back(beam);
+  }
+  return beams;
+}
+
+namespace {
+Eigen::Vector3d atAzimuth(const Eigen::Vector2d& elevation, double azimuth_cos, double azimuth_sin) {
+  return Eigen::Vector3d(elevation.x() * azimuth_cos, elevation.x() * azimuth_sin, elevation.y());
+}
+}  // namespace
+
 Eigen::Vector3d Lidar::direction(int beam, int step) const {
-  const Eigen::Vector2d& elevation = beam_directions_[beam];
-  return Eigen::Vector3d(elevation.x() * azimuth_cos_[step], elevation.x() * azimuth_sin_[step], elevation.y());
+  return atAzimuth(beams_[beam].nominal, azimuth_cos_[step], azimuth_sin_[step]);
+}
+
+Eigen::Vector3d Lidar::actualDirection(int beam, int step) const {
+  return atAzimuth(beams_[beam].actual, azimuth_cos_[step], azimuth_sin_[step]);
 }
 
 SimulatedScan Lidar::sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
@@ -77,7 +110,7 @@ std::vector<Lidar::Return> Lidar::castAll(const RayCaster& scene, const std::vec
     for (int step = 0; step < azimuthSteps(); ++step) {
       const Eigen::Isometry3d& pose = poses.size() == 1 ? poses.front() : poses[step];
       if (hidden_by_vehicle_[static_cast<size_t>(step) * beams + beam]) continue;
-      const Eigen::Vector3d local = direction(beam, step);
+      const Eigen::Vector3d local = actualDirection(beam, step);
       const Ray ray{pose.translation(), pose.linear() * local};
       const auto hit = scene.cast(ray, sensor_.max_range);
       if (!hit || hit->reflectivity <= 0.0f) continue;  // sky, or glass that mirrors the beam away
@@ -144,8 +177,8 @@ SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, 
       };
       const Return& previous = at(step - 1);
       const Return& next = at(step + 1);
-      const double range =
-          clutteredRange(previous, result, next, rng) + rng.gaussian(0.0, sensor_.range_noise_stddev);
+      const double range = clutteredRange(previous, result, next, rng) + beams_[beam].range_offset +
+                           rng.gaussian(0.0, sensor_.range_noise_stddev);
       if (range < sensor_.min_range || range > sensor_.max_range) continue;
       scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
       scan.cloud.intensity.push_back(result.intensity);

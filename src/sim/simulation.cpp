@@ -9,7 +9,9 @@
 namespace elo::sim {
 namespace {
 
-constexpr uint64_t kNoiseStream = 4;   // apart from the world's streams (see world.cpp)
+// Apart from the world's streams (see world.cpp).
+constexpr uint64_t kNoiseStream = 4;
+constexpr uint64_t kCalibrationStream = 5;  // the sequence's seed also picks the unit
 constexpr double kReachMargin = 10.0;  // m of world beyond the sensor's range
 
 Route routeFor(const SimulationSpec& spec) {
@@ -29,7 +31,7 @@ Route routeFor(const SimulationSpec& spec) {
 
 }  // namespace
 
-Simulation::Simulation(const SimulationSpec& spec) : spec_(spec), lidar_(spec.config.sensor, spec.lidar) {
+Simulation::Simulation(const SimulationSpec& spec) : spec_(spec), lidar_(spec.config.sensor, spec.lidar, mixSeed(spec.seed, kCalibrationStream)) {
   if (spec.frames <= 0) throw std::invalid_argument("a simulation needs at least one frame");
   const Route route = routeFor(spec);
   world_ = std::make_unique<World>(spec.world, route,

@@ -1,12 +1,15 @@
 // The sensor on analytic scenes: exact ranges, beams, rings, times, range limits, noise and dropouts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 
 #include "elo/sim/ground.hpp"
 #include "elo/sim/lidar.hpp"
 #include "elo/sim/scene.hpp"
+#include "elo/sim/sensors.hpp"
 #include "sim_test_helpers.hpp"
 
 namespace elo::sim {
@@ -311,6 +314,86 @@ TEST(Lidar, MixedPixelsLieBetweenTheSurfacesOfADepthEdge) {
   EXPECT_EQ(between_count(1.0), 2);
 }
 
+// An HDL-64E with exact ranges apart from its lasers' calibration errors.
+SensorConfig exactHdl64() {
+  Config config;
+  loadSensor("hdl64", config);
+  config.sensor.range_noise_stddev = 0.0;
+  return config.sensor;
+}
+
+// Per ring that saw anything, the value of `of_point` for its points (by index), after checking that
+// it is the same for all of them, as a laser's calibration error is.
+std::vector<double> constantPerRing(const SimulatedScan& scan, int rings, const std::function<double(size_t)>& of_point) {
+  std::vector<double> low(rings, INFINITY), high(rings, -INFINITY);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const double v = of_point(i);
+    low[scan.cloud.ring[i]] = std::min(low[scan.cloud.ring[i]], v);
+    high[scan.cloud.ring[i]] = std::max(high[scan.cloud.ring[i]], v);
+  }
+  std::vector<double> per_ring;
+  for (int ring = 0; ring < rings; ++ring) {
+    if (!std::isfinite(low[ring])) continue;  // the ring saw nothing
+    EXPECT_NEAR(low[ring], high[ring], 2e-4) << "ring " << ring;
+    per_ring.push_back(0.5 * (low[ring] + high[ring]));
+  }
+  return per_ring;
+}
+
+double spread(const std::vector<double>& values) {
+  const double mean = std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+  double squares = 0.0;
+  for (const double v : values) squares += (v - mean) * (v - mean);
+  return std::sqrt(squares / (values.size() - 1));
+}
+
+// Each laser of a miscalibrated unit reads every range long or short by its own offset, the same on
+// every sweep; the offsets spread as asked, and another unit has other offsets.
+TEST(Lidar, EachLaserReadsItsOwnConstantRangeOffset) {
+  constexpr double kBias = 0.02;
+  LidarOptions options = exactOptions();
+  options.beam_range_bias = kBias;
+  const double distance = 12.0;
+  const auto offsets = [&](uint64_t unit, uint64_t sweep) {
+    const Lidar lidar(exactHdl64(), options, unit);
+    const SimulatedScan scan = lidar.sweep(wallScene(distance), atOrigin, 0.0, sweep);
+    EXPECT_GT(scan.cloud.size(), 10000u);
+    return constantPerRing(scan, lidar.beamCount(), [&](size_t i) {
+      const Eigen::Vector3d point = scan.cloud.points[i].cast<double>();
+      return point.norm() - distance / point.normalized().x();  // along the nominal direction
+    });
+  };
+  const std::vector<double> unit_one = offsets(1, 1);
+  ASSERT_EQ(unit_one.size(), 64u);
+  EXPECT_GT(spread(unit_one), 0.6 * kBias);
+  EXPECT_LT(spread(unit_one), 1.4 * kBias);
+  EXPECT_EQ(offsets(1, 2), unit_one);
+  EXPECT_NE(offsets(2, 1), unit_one);
+}
+
+// Each laser of a miscalibrated unit fires off its nominal elevation by its own angle while its points
+// are computed along the nominal one: on a flat road every ring lies at its own height.
+TEST(Lidar, EachLaserFiresOffItsNominalElevation) {
+  constexpr double kErrorDegrees = 0.1;
+  LidarOptions options = exactOptions();
+  options.beam_elevation_error = kErrorDegrees;
+  const SensorConfig sensor = exactHdl64();
+  const Lidar lidar(sensor, options, 1);
+  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+  const std::vector<double> nominal = elevationsOf(sensor);
+  // The elevation each ring really fired at, from its exact range to the road, less its nominal one.
+  const std::vector<double> per_ring = constantPerRing(scan, lidar.beamCount(), [&](size_t i) {
+    return std::asin(-kSensorHeight / scan.cloud.points[i].cast<double>().norm()) - nominal[scan.cloud.ring[i]];
+  });
+  ASSERT_GT(per_ring.size(), 50u);
+  EXPECT_GT(spread(per_ring), 0.6 * kErrorDegrees * M_PI / 180.0);
+  EXPECT_LT(spread(per_ring), 1.4 * kErrorDegrees * M_PI / 180.0);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const Eigen::Vector3d point = scan.cloud.points[i].cast<double>();
+    EXPECT_NEAR(std::asin(point.z() / point.norm()), nominal[scan.cloud.ring[i]], 1e-5);
+  }
+}
+
 TEST(Lidar, RejectsUnusableSensors) {
   SensorConfig sensor = exactSensor();
   sensor.azimuth_steps = 0;
@@ -323,6 +406,12 @@ TEST(Lidar, RejectsUnusableSensors) {
   EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
   options = exactOptions();
   options.mixed_pixel_probability = 2.0;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options = exactOptions();
+  options.beam_range_bias = -0.01;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options = exactOptions();
+  options.beam_elevation_error = -0.1;
   EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
 }
 

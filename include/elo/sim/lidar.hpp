@@ -32,6 +32,14 @@ struct LidarOptions {
   // back from anywhere between the two surfaces, as when the beam's footprint straddles the edge.
   double foliage_depth = 0.0;
   double mixed_pixel_probability = 0.0;
+  // The systematic per-laser errors that a factory calibration leaves in a multi-beam sensor: each
+  // laser reads long or short by its own constant range offset, and points off its nominal elevation
+  // by its own constant angle, while the points are still computed along the nominal elevation. They
+  // make neighbouring rows of the range image disagree by the same step on every scan, as the
+  // "layered misalignment" reported for the HDL-64E S2 does. Each laser's errors are Gaussian with
+  // these standard deviations (m and degrees), drawn once per unit; both off by default.
+  double beam_range_bias = 0.0;
+  double beam_elevation_error = 0.0;
   // The car the sensor is mounted on, in the sensor frame: beams that meet it return nothing (its
   // surfaces lie inside min_range). Empty: a sensor floating free.
   std::vector<Shape> vehicle_body = roofMountedCar();
@@ -49,8 +57,9 @@ struct SimulatedScan {
 
 class Lidar {
  public:
-  // The noise is sensor.range_noise_stddev; throws std::invalid_argument for an unusable sensor.
-  Lidar(const SensorConfig& sensor, const LidarOptions& options);
+  // The noise is sensor.range_noise_stddev; `unit_seed` draws the lasers' calibration errors. Throws
+  // std::invalid_argument for an unusable sensor.
+  Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed = 0);
 
   // One revolution starting at `stamp`. `sensor_pose_at(time)` gives the sensor in the world frame;
   // points are in the sensor frame of their firing, in firing order, with `ring` (0 = top beam) and
@@ -58,10 +67,11 @@ class Lidar {
   SimulatedScan sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
                       double stamp, uint64_t seed) const;
 
-  int beamCount() const { return static_cast<int>(beam_directions_.size()); }
+  int beamCount() const { return static_cast<int>(beams_.size()); }
   int azimuthSteps() const { return static_cast<int>(azimuth_cos_.size()); }
   double sweepDuration() const { return 1.0 / sensor_.rotation_rate_hz; }
-  // Unit direction of a firing in the sensor frame.
+  // Unit direction of a firing in the sensor frame, at the beam's nominal elevation: the direction
+  // its points are reported along.
   Eigen::Vector3d direction(int beam, int step) const;
   const SensorConfig& sensor() const { return sensor_; }
 
@@ -83,7 +93,16 @@ class Lidar {
 
   SensorConfig sensor_;
   LidarOptions options_;
-  std::vector<Eigen::Vector2d> beam_directions_;  // (cos, sin) of each beam's elevation
+  struct Beam {
+    Eigen::Vector2d nominal;  // (cos, sin) of the elevation in the sensor's table
+    Eigen::Vector2d actual;   // (cos, sin) of the elevation the laser really fires at
+    double range_offset = 0.0;  // m that the laser adds to every range it reads
+  };
+  static std::vector<Beam> drawBeams(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed);
+  // Unit direction that a firing's ray really takes.
+  Eigen::Vector3d actualDirection(int beam, int step) const;
+
+  std::vector<Beam> beams_;
   std::vector<double> azimuth_cos_;
   std::vector<double> azimuth_sin_;
   std::vector<bool> hidden_by_vehicle_;  // per firing (step-major, like the returns)
