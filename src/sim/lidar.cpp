@@ -11,6 +11,11 @@
 namespace elo::sim {
 namespace {
 constexpr double kEchoReferenceRange = 10.0;  // m at which the echo strength equals the intensity
+
+// The unit vector at `elevation` (cos, sin) and the azimuth of (azimuth_cos, azimuth_sin).
+Eigen::Vector3d atAzimuth(const Eigen::Vector2d& elevation, double azimuth_cos, double azimuth_sin) {
+  return Eigen::Vector3d(elevation.x() * azimuth_cos, elevation.x() * azimuth_sin, elevation.y());
+}
 }  // namespace
 
 std::vector<Shape> LidarOptions::roofMountedCar() {
@@ -75,12 +80,6 @@ std::vector<Lidar::Beam> Lidar::drawBeams(const SensorConfig& sensor, const Lida
   }
   return beams;
 }
-
-namespace {
-Eigen::Vector3d atAzimuth(const Eigen::Vector2d& elevation, double azimuth_cos, double azimuth_sin) {
-  return Eigen::Vector3d(elevation.x() * azimuth_cos, elevation.x() * azimuth_sin, elevation.y());
-}
-}  // namespace
 
 Eigen::Vector3d Lidar::direction(int beam, int step) const {
   return atAzimuth(beams_[beam].nominal, azimuth_cos_[step], azimuth_sin_[step]);
