@@ -31,7 +31,8 @@ Route routeFor(const SimulationSpec& spec) {
 
 }  // namespace
 
-Simulation::Simulation(const SimulationSpec& spec) : spec_(spec), lidar_(spec.config.sensor, spec.lidar, mixSeed(spec.seed, kCalibrationStream)) {
+Simulation::Simulation(const SimulationSpec& spec)
+    : spec_(spec), lidar_(spec.config.sensor, spec.lidar, mixSeed(spec.seed, kCalibrationStream)) {
   if (spec.frames <= 0) throw std::invalid_argument("a simulation needs at least one frame");
   const Route route = routeFor(spec);
   world_ = std::make_unique<World>(spec.world, route,

@@ -1,4 +1,5 @@
-// The sensor on analytic scenes: exact ranges, beams, rings, times, range limits, noise and dropouts.
+// The sensor on analytic scenes: exact ranges, beams, rings, times, range limits, noise, dropouts, clutter
+// and per-laser calibration errors.
 #include <gtest/gtest.h>
 
 #include <algorithm>
