@@ -4,11 +4,11 @@
 // point.
 //
 // Which offer a pixel or cell keeps takes two rounds of closest-wins keys (closest_wins_key.hpp). The
-// first finds the closest offer. In the second, the offers on the same surface as the closest one (within
-// model.same_surface_distance of its range) compete by age, and the oldest wins; equal ages, as the
-// points of one scan have, fall to the lower source. A surface in front
-// thus still replaces what it hides, as the paper's "closer wins" intends, while the noisy ranges of one
-// surface seen again are not filtered for their nearest: which one stays no longer depends on its noise.
+// first finds the closest offer. In the second, the offers on the same surface as the closest one
+// (within model.same_surface_distance of its range) compete by age, and the oldest wins; equal ages, as
+// the points of one scan have, fall to the lower source. A surface in front thus still replaces what it
+// hides, as the paper's "closer wins" intends, while the noisy ranges of one surface seen again are not
+// filtered for their nearest: which one stays no longer depends on its noise.
 #pragma once
 
 #include "core/common/closest_wins_key.hpp"

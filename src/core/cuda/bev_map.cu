@@ -4,9 +4,9 @@
 // Order of the compact points. The CPU backend inserts sources one at a time (BevImage::keepCloser()): a
 // cell's point takes the next slot when the cell is first offered a point, and a closer point arriving
 // later overwrites that slot's values. Here every source offers itself to its cell twice at once, with an
-// atomicMin of its closest-wins key (the first round of which point stays) and of its source index (which
-// source arrived first). The first arrivals, prefix-summed in source order, give the slots, so both backends' maps agree
-// element by element, in the same order.
+// atomicMin of its closest-wins key (the first round of which point stays) and of its source index
+// (which source arrived first). The first arrivals, prefix-summed in source order, give the slots, so
+// both backends' maps agree element by element, in the same order.
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
