@@ -14,15 +14,14 @@ struct Fixture {
   Config config;
   SphericalProjection spherical = SphericalProjection::fromConfig(config.sensor);
   BevProjection bev = BevProjection::fromConfig(config.bev);
-  cpu::ClosestWins closest, winners;
+  cpu::SphericalFusionScratch scratch;
 
   // The spherical model, a scan and the fused result: empty, of the projection's size.
   SphericalImage model, fused;
   ScanImage scan;
 
   Fixture() {
-    winners.resize(static_cast<size_t>(spherical.rows) * spherical.cols);
-    closest.resize(static_cast<size_t>(spherical.rows) * spherical.cols);
+    scratch.resize(static_cast<size_t>(spherical.rows) * spherical.cols);
     model.resize(spherical.rows, spherical.cols);
     fused.resize(spherical.rows, spherical.cols);
     scan.resize(spherical.rows, spherical.cols);
@@ -37,7 +36,7 @@ struct Fixture {
   // Fuses `scan` into `model` at time `now`, leaving the result in `fused`.
   void fuse(const Eigen::Isometry3d& model_from_scan, float now) {
     const auto fusion = ModelFusion::fromConfig(config.model, now);
-    cpu::fuseSphericalModel(model, scan, spherical, model_from_scan, fusion, closest, winners, fused);
+    cpu::fuseSphericalModel(model, scan, spherical, model_from_scan, fusion, scratch, fused);
   }
   static void put(SphericalImage& image, size_t pixel, const Vec3f& p, float stamp) {
     image.vertex[pixel] = p;

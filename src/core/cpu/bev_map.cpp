@@ -17,28 +17,46 @@ void buildGroundMap(const ScanImage& scan, const BevProjection& projection, floa
     int row = 0;
     int col = 0;
     if (!projection.cellOf(image.vertex[pixel], row, col)) continue;
-    offers.push_back({row * projection.cols + col, image.vertex[pixel], image.stamp[pixel], static_cast<uint32_t>(pixel)});
+    offers.emplace_back(row * projection.cols + col, image.vertex[pixel], image.stamp[pixel],
+                        static_cast<uint32_t>(pixel));
   }
   fillGroundMap(offers, same_surface_distance, ground);
 }
 
 void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map) {
   map.clear();
-  for (const GroundOffer& offer : offers) map.keepCloser(offer.cell, offer.vertex, offer.stamp);
-  std::vector<ClosestKey> oldest(map.size(), kNoClosestKey);
-  std::vector<const GroundOffer*> winners(map.size(), nullptr);
-  for (const GroundOffer& offer : offers) {
-    const int32_t slot = map.point_of_cell[offer.cell];
-    if (!onClosestSurface(norm(toFloat3(offer.vertex)), map.range[slot], same_surface_distance)) continue;
+  // Round 1: the closest offer's range per cell. A cell takes the next slot at its first offer.
+  std::vector<int32_t> slot_of_offer(offers.size());
+  for (size_t i = 0; i < offers.size(); ++i) {
+    const GroundOffer& offer = offers[i];
+    int32_t& slot = map.point_of_cell[offer.cell];
+    if (slot < 0) {
+      slot = static_cast<int32_t>(map.cell.size());
+      map.cell.push_back(offer.cell);
+      map.range.push_back(offer.range);
+    } else if (offer.range < map.range[slot]) {
+      map.range[slot] = offer.range;
+    }
+    slot_of_offer[i] = slot;
+  }
+  // Round 2: the oldest offer on that surface.
+  std::vector<ClosestKey> oldest(map.cell.size(), kNoClosestKey);
+  std::vector<const GroundOffer*> winners(map.cell.size(), nullptr);
+  for (size_t i = 0; i < offers.size(); ++i) {
+    const GroundOffer& offer = offers[i];
+    const int32_t slot = slot_of_offer[i];
+    if (!onClosestSurface(offer.range, map.range[slot], same_surface_distance)) continue;
     const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
     if (key < oldest[slot]) {
       oldest[slot] = key;
       winners[slot] = &offer;
     }
   }
-  for (size_t slot = 0; slot < map.size(); ++slot) {
+  map.vertex.resize(map.cell.size());
+  map.stamp.resize(map.cell.size());
+  for (size_t slot = 0; slot < map.cell.size(); ++slot) {
     map.vertex[slot] = winners[slot]->vertex;
-    map.range[slot] = norm(toFloat3(winners[slot]->vertex));
+    map.range[slot] = winners[slot]->range;
     map.stamp[slot] = winners[slot]->stamp;
   }
 }

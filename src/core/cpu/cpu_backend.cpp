@@ -27,7 +27,7 @@ CpuBackend::CpuBackend(const Config& config)
   allocate(model_, spherical_, bev_);
   allocate(fused_, spherical_, bev_);
   winners_.resize(scan_.image.pixelCount());
-  closest_.resize(scan_.image.pixelCount());
+  fusion_scratch_.resize(scan_.image.pixelCount());
 }
 
 size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp) {
@@ -79,10 +79,9 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   }
   const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
   arena_.execute([&] {
-    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, closest_, winners_,
-                       fused_.nonground);
+    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, fusion_scratch_, fused_.nonground);
+    fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_.ground);
   });
-  fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_.ground);
   std::swap(model_, fused_);
   model_.initialized = true;
   ground_normals_.reset(model_.ground.size());

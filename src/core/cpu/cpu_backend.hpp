@@ -36,8 +36,8 @@ class CpuBackend final : public Backend {
   BevImage scan_ground_;
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_
-  ClosestWins winners_;
-  ClosestWins closest_;  // the model update's first round
+  ClosestWins winners_;  // the projection's closest point per pixel
+  SphericalFusionScratch fusion_scratch_;
   NormalScratch normal_scratch_;
   GroundNormalCache ground_normals_;
 };

@@ -4,6 +4,8 @@
 // stays, and points older than tau_w go. Only three 2D maps are kept (vertex and normal maps of the SRI,
 // vertex map of the BEV), so memory never grows. The per-point rules are shared with the CUDA backend
 // (model_update.hpp).
+#include <algorithm>
+
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/cpu/parallel.hpp"
@@ -11,47 +13,73 @@
 
 namespace elo::cpu {
 
+void SphericalFusionScratch::resize(size_t pixels) {
+  closest.resize(pixels);
+  oldest.resize(pixels);
+  moved_pixel.resize(pixels);
+  moved_range.resize(pixels);
+}
+
+namespace {
+
+// Moves model pixel `pixel` into the scan's frame and notes where it lands: -1 when it is not offered
+// (empty, no normal, expired, or out of the image).
+void moveModelPoint(const SphericalImage& model, size_t pixel, const Rigid3f& scan_from_model,
+                    const SphericalProjection& projection, const ModelFusion& fusion, SphericalFusionScratch& scratch) {
+  scratch.moved_pixel[pixel] = -1;
+  if (!model.occupied(pixel) || !model.hasNormal(pixel)) return;
+  if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return;
+  const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
+  int row = 0;
+  int col = 0;
+  if (!projection.pixelOf(moved, row, col)) return;
+  scratch.moved_pixel[pixel] = row * projection.cols + col;
+  scratch.moved_range[pixel] = norm(moved);
+}
+
+}  // namespace
+
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, ClosestWins& closest,
-                        ClosestWins& winners, SphericalImage& fused) {
+                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion,
+                        SphericalFusionScratch& scratch, SphericalImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
   const uint32_t pixels = static_cast<uint32_t>(model.pixelCount());
   const SphericalImage& observed = scan.image;
-  // Calls offer(pixel, range, stamp, source) for every current model point, moved, and every scan point
-  // that joins the model.
-  const auto forEachOffer = [&](const auto& offer) {
-    parallelFor(pixels, [&](size_t pixel) {
-      if (!model.occupied(pixel) || !model.hasNormal(pixel)) return;
-      if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return;
-      const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
-      int row = 0;
-      int col = 0;
-      if (!projection.pixelOf(moved, row, col)) return;
-      const size_t target = static_cast<size_t>(row) * projection.cols + col;
-      offer(target, norm(moved), model.stamp[pixel], static_cast<uint32_t>(pixel));
-    });
-    parallelFor(pixels, [&](size_t pixel) {
-      if (!joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) return;
+  // Calls offer(pixel, range, stamp, source) for the model point at `pixel`, moved (moveModelPoint()
+  // must have run), and for the scan point at `pixel` if it joins the model.
+  const auto offersFrom = [&](size_t pixel, const auto& offer) {
+    const int32_t target = scratch.moved_pixel[pixel];
+    if (target >= 0) offer(target, scratch.moved_range[pixel], model.stamp[pixel], static_cast<uint32_t>(pixel));
+    if (joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) {
       offer(pixel, observed.range[pixel], observed.stamp[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
-    });
+    }
   };
 
+  ClosestWins& closest = scratch.closest;
+  ClosestWins& oldest = scratch.oldest;
   closest.reset();
-  forEachOffer([&](size_t pixel, float range, float, uint32_t source) { closest.offer(pixel, range, source); });
-  winners.reset();
-  forEachOffer([&](size_t pixel, float range, float observed_at, uint32_t source) {
-    if (onClosestSurface(range, closest.range(pixel), fusion.same_surface_distance)) {
-      winners.offerKey(pixel, oldestWinsKey(observed_at, source));
-    }
+  oldest.reset();
+  // Round 1 moves each model point once; round 2 reuses where it landed.
+  parallelFor(pixels, [&](size_t pixel) {
+    moveModelPoint(model, pixel, scan_from_model, projection, fusion, scratch);
+    offersFrom(pixel,
+               [&](size_t target, float range, float, uint32_t source) { closest.offer(target, range, source); });
+  });
+  parallelFor(pixels, [&](size_t pixel) {
+    offersFrom(pixel, [&](size_t target, float range, float observed_at, uint32_t source) {
+      if (onClosestSurface(range, closest.range(target), fusion.same_surface_distance)) {
+        oldest.offerKey(target, oldestWinsKey(observed_at, source));
+      }
+    });
   });
 
   parallelFor(pixels, [&](size_t pixel) {
-    if (!winners.occupied(pixel)) {
+    if (!oldest.occupied(pixel)) {
       fused.range[pixel] = 0.0f;
       fused.normal[pixel].setZero();
       return;
     }
-    const uint32_t source = winners.winner(pixel);
+    const uint32_t source = oldest.winner(pixel);
     if (isScanSource(source, pixels)) {
       const size_t from = source - pixels;
       fused.vertex[pixel] = observed.vertex[from];
@@ -59,10 +87,9 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
       fused.range[pixel] = observed.range[from];
       fused.stamp[pixel] = observed.stamp[from];
     } else {
-      const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[source]));
-      fused.vertex[pixel] = toVec3f(moved);
+      fused.vertex[pixel] = toVec3f(scan_from_model.apply(toFloat3(model.vertex[source])));
       fused.normal[pixel] = toVec3f(scan_from_model.rotate(toFloat3(model.normal[source])));
-      fused.range[pixel] = norm(moved);
+      fused.range[pixel] = scratch.moved_range[source];
       fused.stamp[pixel] = model.stamp[source];
     }
   });
@@ -71,20 +98,25 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
+  // Model points move in parallel, each into its own entry; the ones not offered are then removed in
+  // order, so the offers keep the order of their sources, which gives the map's slots.
   std::vector<GroundOffer> offers;
   offers.reserve(model.size() + scan_ground.size());
-  for (size_t point = 0; point < model.size(); ++point) {
-    if (!isCurrent(fusion.now, model.stamp[point], fusion.time_window)) continue;
+  offers.resize(model.size());
+  parallelFor(model.size(), [&](size_t point) {
+    if (!isCurrent(fusion.now, model.stamp[point], fusion.time_window)) return;
     const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[point]));
     int row = 0;
     int col = 0;
-    if (!projection.cellOf(moved, row, col)) continue;
-    offers.push_back({row * projection.cols + col, toVec3f(moved), model.stamp[point], static_cast<uint32_t>(point)});
-  }
+    if (!projection.cellOf(moved, row, col)) return;
+    offers[point] = {row * projection.cols + col, toVec3f(moved), model.stamp[point], static_cast<uint32_t>(point)};
+  });
+  offers.erase(std::remove_if(offers.begin(), offers.end(), [](const GroundOffer& offer) { return offer.cell < 0; }),
+               offers.end());
   const uint32_t model_points = static_cast<uint32_t>(model.size());
   for (size_t point = 0; point < scan_ground.size(); ++point) {
-    offers.push_back({scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
-                      model_points + static_cast<uint32_t>(point)});
+    offers.emplace_back(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
+                        model_points + static_cast<uint32_t>(point));
   }
   fillGroundMap(offers, fusion.same_surface_distance, fused);
 }

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
 #include "core/cpu/closest_wins.hpp"
@@ -51,12 +52,18 @@ void estimateNormals(const NormalConfig& config, const SphericalProjection& proj
 // (fillGroundMap below).
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
                     BevImage& ground);
-// A point offered to a cell of a ground map by source `source` (the numbering the CUDA backend uses).
+// A point offered to a cell of a ground map by source `source` (the numbering the CUDA backend uses);
+// cell -1 offers nothing.
 struct GroundOffer {
-  int32_t cell;
+  int32_t cell = -1;
   Vec3f vertex;
-  float stamp;
-  uint32_t source;
+  float range = 0.0f;  // distance to the sensor, as BevImage computes it
+  float stamp = 0.0f;
+  uint32_t source = 0;
+
+  GroundOffer() = default;
+  GroundOffer(int32_t to_cell, const Vec3f& point, float observed_at, uint32_t from_source)
+      : cell(to_cell), vertex(point), range(norm(toFloat3(point))), stamp(observed_at), source(from_source) {}
 };
 // Fills `map` with `offers` by the two rounds of model_update.hpp: each cell keeps the oldest offer on its
 // closest surface. Slots follow the first offer to each cell.
@@ -92,10 +99,21 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
 
 // model_update.cpp: moves the model into the scan's frame and fuses the scan into it: the closest surface
 // wins a pixel and its oldest point stays (model_update.hpp); model points older than the time window go.
-// Results go to `fused`; `closest` and `winners` are scratch for the two rounds.
+// Results go to `fused`.
+//
+// The spherical update's scratch, kept by the backend to reuse its memory: each pixel's winner of each
+// round, and where each model pixel lands once moved into the scan's frame.
+struct SphericalFusionScratch {
+  ClosestWins closest;               // round 1: the closest offer
+  ClosestWins oldest;                // round 2: the oldest offer on the closest surface
+  std::vector<int32_t> moved_pixel;  // per model pixel: the pixel it lands on; -1 when it is not offered
+  std::vector<float> moved_range;    // its range there
+
+  void resize(size_t pixels);
+};
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
-                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, ClosestWins& closest,
-                        ClosestWins& winners, SphericalImage& fused);
+                        const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion,
+                        SphericalFusionScratch& scratch, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused);
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.

@@ -1,12 +1,11 @@
 // Sec. III-C.2 and III-D on the GPU: BEV maps that keep in each cell the oldest point on the surface
 // closest to the sensor (the two rounds of model_update.hpp), and the normals of the BEV model.
 //
-// Order of the compact points. The CPU backend inserts sources one at a time (BevImage::keepCloser()): a
-// cell's point takes the next slot when the cell is first offered a point, and a closer point arriving
-// later overwrites that slot's values. Here every source offers itself to its cell twice at once, with an
-// atomicMin of its closest-wins key (the first round of which point stays) and of its source index
-// (which source arrived first). The first arrivals, prefix-summed in source order, give the slots, so
-// both backends' maps agree element by element, in the same order.
+// Order of the compact points. The CPU backend offers sources one at a time (fillGroundMap()): a cell
+// takes the next slot when it is first offered a point. Here every source offers itself to its cell
+// twice at once, with an atomicMin of its closest-wins key (the first round of which point stays) and of
+// its source index (which source arrived first). The first arrivals, prefix-summed in source order, give
+// the slots, so both backends' maps agree element by element, in the same order.
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
