@@ -202,6 +202,75 @@ TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
   EXPECT_EQ(map.vertex[0], nearer);
 }
 
+// Both backends give a cell the next slot when it is first offered a point, so their maps agree element
+// by element (bev_map.cu); the CPU's fill must keep that order whatever point a cell keeps.
+TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
+  Fixture f;
+  BevImage map;
+  map.resize(f.bev.rows, f.bev.cols);
+  const auto cell_of = [&](const Vec3f& p) {
+    int row = 0;
+    int col = 0;
+    EXPECT_TRUE(f.bev.cellOf(p, row, col));
+    return row * f.bev.cols + col;
+  };
+  const Vec3f b_far(3.05f, 1.02f, -1.73f);
+  const Vec3f b_near(3.01f, 1.01f, -0.50f);  // another surface in the same cell, 0.4 m nearer
+  const Vec3f a_old(8.02f, 2.02f, -1.73f);
+  const Vec3f a_new(8.01f, 2.01f, -1.71f);  // the same road as a_old
+  const Vec3f c(-15.0f, 6.0f, -1.73f);
+  const int32_t a = cell_of(a_old);
+  const int32_t b = cell_of(b_far);
+  ASSERT_EQ(cell_of(a_new), a);
+  ASSERT_EQ(cell_of(b_near), b);
+  ASSERT_GT(cell_of(c), a);  // the slots' order is not the cells'
+  ASSERT_GT(a, b);
+  const std::vector<cpu::GroundOffer> offers = {
+      {cell_of(c), c, 2.0f, 0}, {b, b_far, 1.0f, 1}, {a, a_new, 2.0f, 2}, {b, b_near, 2.0f, 3}, {a, a_old, 1.0f, 4}};
+  cpu::fillGroundMap(offers, 0.3f, map);
+  ASSERT_EQ(map.cell, (std::vector<int32_t>{cell_of(c), b, a}));
+  for (int32_t slot = 0; slot < 3; ++slot) EXPECT_EQ(map.point_of_cell[map.cell[slot]], slot);
+  EXPECT_EQ(map.vertex[0], c);
+  EXPECT_EQ(map.vertex[1], b_near) << "a nearer surface replaces what it hides";
+  EXPECT_EQ(map.vertex[2], a_old) << "one surface seen again keeps its oldest point";
+  EXPECT_EQ(map.stamp, (std::vector<float>{2.0f, 2.0f, 1.0f}));
+  for (int32_t slot = 0; slot < 3; ++slot) EXPECT_FLOAT_EQ(map.range[slot], map.vertex[slot].norm());
+}
+
+// The fused map lists the model's surviving points in their order, then the scan's new cells.
+TEST(ModelUpdate, FusedGroundMapKeepsTheModelsOrderThenTheScans) {
+  Fixture f;
+  BevImage model;
+  model.resize(f.bev.rows, f.bev.cols);
+  BevImage scan_ground;
+  scan_ground.resize(f.bev.rows, f.bev.cols);
+  BevImage fused;
+  fused.resize(f.bev.rows, f.bev.cols);
+  const auto cell_of = [&](const Vec3f& p) {
+    int row = 0;
+    int col = 0;
+    EXPECT_TRUE(f.bev.cellOf(p, row, col));
+    return row * f.bev.cols + col;
+  };
+  const Vec3f y(5.0f, 9.0f, -1.73f);
+  const Vec3f x(12.0f, -3.0f, -1.73f);
+  const Vec3f expired(-20.0f, 0.0f, -1.73f);
+  const Vec3f z(30.0f, 1.0f, -1.73f);
+  const Vec3f w(-6.0f, -6.0f, -1.73f);
+  model.keepCloser(cell_of(expired), expired, 0.0f);
+  model.keepCloser(cell_of(y), y, 5.0f);
+  model.keepCloser(cell_of(x), x, 5.0f);
+  model.keepCloser(cell_of(z), z, 5.0f);
+  scan_ground.keepCloser(cell_of(w), w, 12.0f);
+  scan_ground.keepCloser(cell_of(x), x + Vec3f(0.0f, 0.0f, 0.01f), 12.0f);
+  cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
+                       ModelFusion::fromConfig(f.config.model, 12.0f), fused);
+  ASSERT_GT(cell_of(y), cell_of(z));  // the slots' order is not the cells'
+  EXPECT_EQ(fused.cell, (std::vector<int32_t>{cell_of(y), cell_of(x), cell_of(z), cell_of(w)}));
+  EXPECT_EQ(fused.vertex, (std::vector<Vec3f>{y, x, z, w}));
+  EXPECT_EQ(fused.stamp, (std::vector<float>{5.0f, 5.0f, 5.0f, 12.0f}));
+}
+
 TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
   Fixture f;
   BevImage model;
