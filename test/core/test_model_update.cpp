@@ -33,6 +33,19 @@ struct Fixture {
     EXPECT_TRUE(spherical.pixelOf(p, row, col));
     return static_cast<size_t>(row) * spherical.cols + col;
   }
+  // The BEV cell of a ground point, which must lie in the map.
+  int32_t cellOf(const Vec3f& p) const {
+    int row = 0;
+    int col = 0;
+    EXPECT_TRUE(bev.cellOf(p, row, col));
+    return row * bev.cols + col;
+  }
+  // An empty BEV map of the configured grid.
+  BevImage emptyBevMap() const {
+    BevImage map;
+    map.resize(bev.rows, bev.cols);
+    return map;
+  }
   // Fuses `scan` into `model` at time `now`, leaving the result in `fused`.
   void fuse(const Eigen::Isometry3d& model_from_scan, float now) {
     const auto fusion = ModelFusion::fromConfig(config.model, now);
@@ -145,24 +158,15 @@ TEST(ModelUpdate, ModelPointsMoveIntoTheNewFrameAndExpire) {
 
 TEST(ModelUpdate, GroundMapKeepsTheOldestPointOfTheRoadAndExpiresOldOnes) {
   Fixture f;
-  BevImage model;
-  model.resize(f.bev.rows, f.bev.cols);
-  BevImage scan_ground;
-  scan_ground.resize(f.bev.rows, f.bev.cols);
-  BevImage fused;
-  fused.resize(f.bev.rows, f.bev.cols);
-  const auto cell_of = [&](const Vec3f& p) {
-    int row = 0;
-    int col = 0;
-    EXPECT_TRUE(f.bev.cellOf(p, row, col));
-    return row * f.bev.cols + col;
-  };
+  BevImage model = f.emptyBevMap();
+  BevImage scan_ground = f.emptyBevMap();
+  BevImage fused = f.emptyBevMap();
   const Vec3f kept(10.02f, 3.03f, -1.73f);
   const Vec3f old(-7.0f, 1.0f, -1.73f);
-  model.keepCloser(cell_of(kept), kept, 4.0f);
-  model.keepCloser(cell_of(old), old, 0.0f);
+  model.keepCloser(f.cellOf(kept), kept, 4.0f);
+  model.keepCloser(f.cellOf(old), old, 0.0f);
   const Vec3f closer(10.01f, 3.02f, -1.72f);  // the same road in the same cell, a little nearer the sensor
-  scan_ground.keepCloser(cell_of(closer), closer, 12.0f);
+  scan_ground.keepCloser(f.cellOf(closer), closer, 12.0f);
 
   const auto fuseAt12 = [&] {
     cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
@@ -170,29 +174,25 @@ TEST(ModelUpdate, GroundMapKeepsTheOldestPointOfTheRoadAndExpiresOldOnes) {
   };
   fuseAt12();
   ASSERT_EQ(fused.size(), 1u) << "the point observed 12 s ago must have expired";
-  const int32_t point = fused.point_of_cell[cell_of(kept)];
+  const int32_t point = fused.point_of_cell[f.cellOf(kept)];
   ASSERT_GE(point, 0);
   EXPECT_TRUE(fused.vertex[point].isApprox(kept));
   EXPECT_FLOAT_EQ(fused.stamp[point], 4.0f);
-  EXPECT_FALSE(fused.occupied(cell_of(old)));
+  EXPECT_FALSE(fused.occupied(f.cellOf(old)));
 
   f.config.model.same_surface_distance = 0.0;  // the paper's literal rule: the closer always wins
   fuseAt12();
-  EXPECT_TRUE(fused.vertex[fused.point_of_cell[cell_of(kept)]].isApprox(closer));
+  EXPECT_TRUE(fused.vertex[fused.point_of_cell[f.cellOf(kept)]].isApprox(closer));
 }
 
 // Within one scan every point has the same age: of the points of one surface in a cell the lower source
 // (pixel) stays, whatever its noise; the literal rule keeps the nearest.
 TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
   Fixture f;
-  BevImage map;
-  map.resize(f.bev.rows, f.bev.cols);
+  BevImage map = f.emptyBevMap();
   const Vec3f farther(10.05f, 3.04f, -1.75f);
   const Vec3f nearer(10.01f, 3.01f, -1.72f);
-  int row = 0;
-  int col = 0;
-  ASSERT_TRUE(f.bev.cellOf(farther, row, col));
-  const int32_t cell = row * f.bev.cols + col;
+  const int32_t cell = f.cellOf(farther);
   const std::vector<cpu::GroundOffer> offers = {{cell, nearer, 1.0f, 9}, {cell, farther, 1.0f, 7}};
   cpu::fillGroundMap(offers, 0.3f, map);
   ASSERT_EQ(map.size(), 1u);
@@ -206,29 +206,22 @@ TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
 // by element (bev_map.cu); the CPU's fill must keep that order whatever point a cell keeps.
 TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
   Fixture f;
-  BevImage map;
-  map.resize(f.bev.rows, f.bev.cols);
-  const auto cell_of = [&](const Vec3f& p) {
-    int row = 0;
-    int col = 0;
-    EXPECT_TRUE(f.bev.cellOf(p, row, col));
-    return row * f.bev.cols + col;
-  };
+  BevImage map = f.emptyBevMap();
   const Vec3f b_far(3.05f, 1.02f, -1.73f);
   const Vec3f b_near(3.01f, 1.01f, -0.50f);  // another surface in the same cell, 0.4 m nearer
   const Vec3f a_old(8.02f, 2.02f, -1.73f);
   const Vec3f a_new(8.01f, 2.01f, -1.71f);  // the same road as a_old
   const Vec3f c(-15.0f, 6.0f, -1.73f);
-  const int32_t a = cell_of(a_old);
-  const int32_t b = cell_of(b_far);
-  ASSERT_EQ(cell_of(a_new), a);
-  ASSERT_EQ(cell_of(b_near), b);
-  ASSERT_GT(cell_of(c), a);  // the slots' order is not the cells'
+  const int32_t a = f.cellOf(a_old);
+  const int32_t b = f.cellOf(b_far);
+  ASSERT_EQ(f.cellOf(a_new), a);
+  ASSERT_EQ(f.cellOf(b_near), b);
+  ASSERT_GT(f.cellOf(c), a);  // the slots' order is not the cells'
   ASSERT_GT(a, b);
   const std::vector<cpu::GroundOffer> offers = {
-      {cell_of(c), c, 2.0f, 0}, {b, b_far, 1.0f, 1}, {a, a_new, 2.0f, 2}, {b, b_near, 2.0f, 3}, {a, a_old, 1.0f, 4}};
+      {f.cellOf(c), c, 2.0f, 0}, {b, b_far, 1.0f, 1}, {a, a_new, 2.0f, 2}, {b, b_near, 2.0f, 3}, {a, a_old, 1.0f, 4}};
   cpu::fillGroundMap(offers, 0.3f, map);
-  ASSERT_EQ(map.cell, (std::vector<int32_t>{cell_of(c), b, a}));
+  ASSERT_EQ(map.cell, (std::vector<int32_t>{f.cellOf(c), b, a}));
   for (int32_t slot = 0; slot < 3; ++slot) EXPECT_EQ(map.point_of_cell[map.cell[slot]], slot);
   EXPECT_EQ(map.vertex[0], c);
   EXPECT_EQ(map.vertex[1], b_near) << "a nearer surface replaces what it hides";
@@ -240,64 +233,46 @@ TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
 // The fused map lists the model's surviving points in their order, then the scan's new cells.
 TEST(ModelUpdate, FusedGroundMapKeepsTheModelsOrderThenTheScans) {
   Fixture f;
-  BevImage model;
-  model.resize(f.bev.rows, f.bev.cols);
-  BevImage scan_ground;
-  scan_ground.resize(f.bev.rows, f.bev.cols);
-  BevImage fused;
-  fused.resize(f.bev.rows, f.bev.cols);
-  const auto cell_of = [&](const Vec3f& p) {
-    int row = 0;
-    int col = 0;
-    EXPECT_TRUE(f.bev.cellOf(p, row, col));
-    return row * f.bev.cols + col;
-  };
+  BevImage model = f.emptyBevMap();
+  BevImage scan_ground = f.emptyBevMap();
+  BevImage fused = f.emptyBevMap();
   const Vec3f y(5.0f, 9.0f, -1.73f);
   const Vec3f x(12.0f, -3.0f, -1.73f);
   const Vec3f expired(-20.0f, 0.0f, -1.73f);
   const Vec3f z(30.0f, 1.0f, -1.73f);
   const Vec3f w(-6.0f, -6.0f, -1.73f);
-  model.keepCloser(cell_of(expired), expired, 0.0f);
-  model.keepCloser(cell_of(y), y, 5.0f);
-  model.keepCloser(cell_of(x), x, 5.0f);
-  model.keepCloser(cell_of(z), z, 5.0f);
-  scan_ground.keepCloser(cell_of(w), w, 12.0f);
-  scan_ground.keepCloser(cell_of(x), x + Vec3f(0.0f, 0.0f, 0.01f), 12.0f);
+  model.keepCloser(f.cellOf(expired), expired, 0.0f);
+  model.keepCloser(f.cellOf(y), y, 5.0f);
+  model.keepCloser(f.cellOf(x), x, 5.0f);
+  model.keepCloser(f.cellOf(z), z, 5.0f);
+  scan_ground.keepCloser(f.cellOf(w), w, 12.0f);
+  scan_ground.keepCloser(f.cellOf(x), x + Vec3f(0.0f, 0.0f, 0.01f), 12.0f);
   cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
                        ModelFusion::fromConfig(f.config.model, 12.0f), fused);
-  ASSERT_GT(cell_of(y), cell_of(z));  // the slots' order is not the cells'
-  EXPECT_EQ(fused.cell, (std::vector<int32_t>{cell_of(y), cell_of(x), cell_of(z), cell_of(w)}));
+  ASSERT_GT(f.cellOf(y), f.cellOf(z));  // the slots' order is not the cells'
+  EXPECT_EQ(fused.cell, (std::vector<int32_t>{f.cellOf(y), f.cellOf(x), f.cellOf(z), f.cellOf(w)}));
   EXPECT_EQ(fused.vertex, (std::vector<Vec3f>{y, x, z, w}));
   EXPECT_EQ(fused.stamp, (std::vector<float>{5.0f, 5.0f, 5.0f, 12.0f}));
 }
 
 TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
   Fixture f;
-  BevImage model;
-  model.resize(f.bev.rows, f.bev.cols);
-  BevImage fused;
-  fused.resize(f.bev.rows, f.bev.cols);
-  BevImage scan_ground;
-  scan_ground.resize(f.bev.rows, f.bev.cols);
+  BevImage model = f.emptyBevMap();
+  BevImage fused = f.emptyBevMap();
+  BevImage scan_ground = f.emptyBevMap();
   Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
   step.translation() << 1.0, 0.0, 0.0;  // the sensor advances 1 m a frame
   for (int frame = 0; frame < 1000; ++frame) {
     scan_ground.clear();
     for (int i = 0; i < 50; ++i) {
       const Vec3f p(-10.0f + 0.4f * i, 0.0f, -1.73f);
-      int row = 0;
-      int col = 0;
-      ASSERT_TRUE(f.bev.cellOf(p, row, col));
-      scan_ground.keepCloser(row * f.bev.cols + col, p, 0.1f * frame);
+      scan_ground.keepCloser(f.cellOf(p), p, 0.1f * frame);
     }
     cpu::fuseGroundModel(model, scan_ground, f.bev, step, ModelFusion::fromConfig(f.config.model, 0.1f * frame), fused);
     std::swap(model, fused);
   }
   // A point seen at x = 0 one frame ago now lies at x = -1.
-  int row = 0;
-  int col = 0;
-  ASSERT_TRUE(f.bev.cellOf(Vec3f(-1.0f, 0.0f, -1.73f), row, col));
-  EXPECT_TRUE(model.occupied(row * f.bev.cols + col));
+  EXPECT_TRUE(model.occupied(f.cellOf(Vec3f(-1.0f, 0.0f, -1.73f))));
   // 10 s at 1 m a frame: at most 100 frames of 50 points survive, and the grid never grows.
   EXPECT_LE(model.size(), 100u * 50u);
   EXPECT_EQ(model.point_of_cell.size(), static_cast<size_t>(f.bev.rows) * f.bev.cols);
