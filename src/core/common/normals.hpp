@@ -189,33 +189,21 @@ ELO_HOST_DEVICE Float3 windowNormal(const Image& image, int row, int col, const 
   return towardsSensor(fit.normal, image.vertex(pixel));
 }
 
-// The first usable pixel from (row, col) stepping by (row_step, col_step), at most two steps away; -1
-// when there is none.
-template <typename Image>
-ELO_HOST_DEVICE int nearestAlong(const Image& image, int row, int col, int row_step, int col_step) {
-  for (int step = 1; step <= 2; ++step) {
-    const int r = row + step * row_step;
-    if (r < 0 || r >= image.rows) continue;
-    const int pixel = r * image.cols + wrapColumn(col + step * col_step, image.cols);
-    if (image.usable(pixel)) return pixel;
-  }
-  return -1;
-}
-
-// The cross-product baseline of Table III: the cross product of the horizontal and vertical image
-// gradients at (row, col); zero when a neighbour is missing.
+// The cross-product baseline of Table III, SuMa's: the cross product of the two point pairs from
+// (row, col) to its right and lower neighbours; zero when either is missing.
 template <typename Image>
 ELO_HOST_DEVICE Float3 crossProductNormal(const Image& image, int row, int col) {
   const Float3 none{0.0f, 0.0f, 0.0f};
-  const int left = nearestAlong(image, row, col, 0, -1);
-  const int right = nearestAlong(image, row, col, 0, 1);
-  const int up = nearestAlong(image, row, col, -1, 0);
-  const int down = nearestAlong(image, row, col, 1, 0);
-  if (left < 0 || right < 0 || up < 0 || down < 0) return none;
-  const Float3 normal = cross(image.vertex(right) - image.vertex(left), image.vertex(down) - image.vertex(up));
+  if (row + 1 >= image.rows) return none;
+  const int pixel = row * image.cols + col;
+  const int right = row * image.cols + wrapColumn(col + 1, image.cols);
+  const int down = pixel + image.cols;
+  if (!image.usable(right) || !image.usable(down)) return none;
+  const Float3 centre = image.vertex(pixel);
+  const Float3 normal = cross(image.vertex(right) - centre, image.vertex(down) - centre);
   const float length = norm(normal);
   if (!(length > 0.0f)) return none;
-  return towardsSensor(normal / length, image.vertex(row * image.cols + col));
+  return towardsSensor(normal / length, centre);
 }
 
 // The normal of a non-ground pixel by the configured method.
