@@ -1,5 +1,6 @@
-// elo_eval: KITTI drift, RPE and ATE of estimated trajectories against ground truth, and the map entropy
-// of a trajectory over its scans where there is no ground truth.
+// elo_eval: KITTI drift, RPE and ATE of estimated trajectories against ground truth and, where there is
+// no ground truth, the map entropy of a trajectory over its scans or the gap between a forward and a
+// reverse run.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "elo/eval/evaluation.hpp"
 #include "elo/eval/map_entropy.hpp"
 #include "elo/eval/plot.hpp"
+#include "elo/eval/trajectory_error.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
@@ -26,11 +28,13 @@ constexpr int kExitBadInput = 2;
 const char* const kUsage =
     "usage: elo_eval --gt GT --est EST [--plot PNG] [--tum]\n"
     "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
+    "       elo_eval --est EST --reverse REV\n"
     "\n"
     "Evaluates estimated trajectories against ground truth with the KITTI odometry metric (t_rel, r_rel over\n"
     "segments of 100..800 m), the relative pose error between consecutive frames and the absolute trajectory\n"
     "error after a rigid alignment. Without ground truth, --map-entropy scores one trajectory by the sharpness\n"
-    "of the map its scans make.\n"
+    "of the map its scans make, and --reverse by how far it and a run over the same scans in reverse fail to\n"
+    "close.\n"
     "\n"
     "  --gt GT      a KITTI pose file (12 numbers a line), or a directory of NN.txt pose files\n"
     "  --est EST    the estimate: a file when GT is a file, a directory when GT is one; every NN.txt present\n"
@@ -44,6 +48,10 @@ const char* const kUsage =
     "               the map of their points at 3..30 m and prints its mean map entropy (nats, lower is\n"
     "               sharper) and the mean spread off the local planes within 0.3 m of every 50th map point.\n"
     "               Holds every other point of every scan in memory (about 40 MB per 60 HDL-64E scans)\n"
+    "  --reverse REV\n"
+    "               the trajectory of the same scans played last to first (elo_run --reverse): prints the\n"
+    "               translation and rotation of EST's last pose times REV's last pose, which is the identity\n"
+    "               for a perfect odometry: with a gap g, at least one run ends g/2 or more off\n"
     "  --help       this text\n"
     "\n"
     "Exit status: 0 on success, 2 on bad arguments or unreadable or mismatched inputs.\n";
@@ -53,6 +61,7 @@ struct Options {
   std::string estimate;
   std::optional<std::string> plot;
   std::optional<std::string> map_entropy_scans;
+  std::optional<std::string> reverse;
   bool tum = false;
 };
 
@@ -72,16 +81,18 @@ Options parseArguments(int argc, char** argv) {
       options.tum = true;
     } else if (arguments.is("--map-entropy")) {
       options.map_entropy_scans = arguments.value();
+    } else if (arguments.is("--reverse")) {
+      options.reverse = arguments.value();
     } else {
       arguments.rejectFlag();
     }
   }
   if (options.estimate.empty()) throw UsageError("--est is required");
-  if (options.ground_truth.empty() && !options.map_entropy_scans) {
-    throw UsageError("--gt is required unless --map-entropy is given");
+  if (options.ground_truth.empty() && !options.map_entropy_scans && !options.reverse) {
+    throw UsageError("--gt is required unless --map-entropy or --reverse is given");
   }
-  if (options.map_entropy_scans && fs::is_directory(options.estimate)) {
-    throw UsageError("--map-entropy scores one trajectory: --est must be a file");
+  if ((options.map_entropy_scans || options.reverse) && fs::is_directory(options.estimate)) {
+    throw UsageError("--map-entropy and --reverse score one trajectory: --est must be a file");
   }
   return options;
 }
@@ -182,8 +193,24 @@ void printMapEntropy(const Options& options) {
               entropy.map_points);
 }
 
+// The gap between the forward run in options.estimate and the reverse run in options.reverse.
+void printForwardBackwardGap(const Options& options) {
+  elo::ForwardBackwardGap gap;
+  try {
+    gap = elo::forwardBackwardGap(readTrajectory(options.estimate, options.tum),
+                                  readTrajectory(*options.reverse, options.tum));
+  } catch (const std::invalid_argument& error) {
+    throw elo::IoError("'" + options.estimate + "' against '" + *options.reverse + "': " + error.what());
+  }
+  std::printf("forward-backward gap %.4f m, %.4f deg over %zu scans and %.1f m", gap.translation_m, gap.rotation_deg,
+              gap.frames, gap.length_m);
+  if (gap.length_m > 0.0) std::printf(" (%.3f %% of the length)", 100.0 * gap.translation_m / gap.length_m);
+  std::printf("\n");
+}
+
 int run(const Options& options) {
   if (options.map_entropy_scans) printMapEntropy(options);
+  if (options.reverse) printForwardBackwardGap(options);
   if (options.ground_truth.empty()) return 0;
   const std::vector<SequenceFiles> sequences = pairSequenceFiles(options);
   const bool directories = fs::is_directory(options.ground_truth);

@@ -34,7 +34,11 @@ options:
   --threads N          CPU threads (default: all)
   --backend cpu|cuda   compute backend (runtime.backend; default cpu)
   --set KEY=VALUE      override one parameter, e.g. --set ground.sensor_height=1.8 (repeatable)
-  --frames N           process only the first N scans
+  --frames N           process only the first N scans (of those --stride and --reverse play)
+  --stride K           play every K-th scan from the first: a faster drive, or dropped frames
+                       (default 1); score it against every K-th ground-truth pose
+  --reverse            play the scans last to first, the route driven backwards (stamps mirrored
+                       so time still advances); elo_eval --reverse compares it with a forward run
   --timing CSV         per-frame stage times, iterations, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
@@ -52,6 +56,8 @@ struct Options {
   std::string camera_output;
   std::vector<std::pair<std::string, std::string>> overrides;
   size_t max_frames = 0;
+  size_t stride = 1;
+  bool reverse = false;
   bool quiet = false;
   bool dump_config = false;
 };
@@ -83,6 +89,11 @@ Options parseArguments(int argc, char** argv) {
       options.overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
     } else if (arguments.is("--frames")) {
       options.max_frames = arguments.number<size_t>();
+    } else if (arguments.is("--stride")) {
+      options.stride = arguments.number<size_t>();
+      if (options.stride == 0) throw UsageError("--stride must be at least 1");
+    } else if (arguments.is("--reverse")) {
+      options.reverse = true;
     } else if (arguments.is("--timing")) {
       options.timing_csv = arguments.value();
     } else if (arguments.is("--tum")) {
@@ -210,7 +221,8 @@ int run(const Options& options) {
     return 0;
   }
   const elo::Sequence sequence(options.input);
-  const size_t scans = options.max_frames > 0 ? std::min(options.max_frames, sequence.size()) : sequence.size();
+  const std::vector<elo::PlayedScan> played = elo::playOrder(sequence, options.stride, options.reverse, options.max_frames);
+  const size_t scans = played.size();
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
   std::ofstream timing;
@@ -228,13 +240,15 @@ int run(const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < scans; ++i) {
     size_t non_finite = 0;
-    const elo::PointCloud cloud = sequence.load(i, &non_finite);
+    elo::PointCloud cloud = sequence.load(played[i].index, &non_finite);
+    cloud.stamp = played[i].stamp;
     non_finite_points += non_finite;
     const elo::FrameResult result = odometry.process(cloud);
-    if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", i, result.skip_reason.c_str());
-    if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", i);
+    const size_t scan = played[i].index;
+    if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
+    if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
     if (result.gap_restart) {
-      std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", i);
+      std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", scan);
     }
     poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned with scans
     stamps.push_back(cloud.stamp);

@@ -6,7 +6,10 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
+#include "elo/eval/kitti_metric.hpp"
 #include "relative_motion.hpp"
 
 namespace elo {
@@ -67,6 +70,22 @@ AbsoluteTrajectoryError absoluteTrajectoryError(const std::vector<Eigen::Isometr
   const Eigen::Matrix3Xd residuals = (ate.alignment * estimated_positions) - gt_positions;
   ate.translation_rmse_m = std::sqrt(residuals.colwise().squaredNorm().mean());
   return ate;
+}
+
+ForwardBackwardGap forwardBackwardGap(const std::vector<Eigen::Isometry3d>& forward,
+                                      const std::vector<Eigen::Isometry3d>& reverse) {
+  if (forward.empty() || forward.size() != reverse.size()) {
+    throw std::invalid_argument("the forward run has " + std::to_string(forward.size()) +
+                                " poses and the reverse run " + std::to_string(reverse.size()) +
+                                ": they must cover the same scans");
+  }
+  const Eigen::Isometry3d round_trip = forward.back() * reverse.back();
+  ForwardBackwardGap gap;
+  gap.frames = forward.size();
+  gap.length_m = trajectoryDistances(forward).back();
+  gap.translation_m = round_trip.translation().norm();
+  gap.rotation_deg = rotationAngleDeg(round_trip.linear());
+  return gap;
 }
 
 }  // namespace elo

@@ -125,4 +125,17 @@ const std::vector<Eigen::Isometry3d>& Sequence::groundTruth() const {
   return ground_truth_;
 }
 
+std::vector<PlayedScan> playOrder(const Sequence& sequence, size_t stride, bool reverse, size_t max_frames) {
+  if (stride == 0) throw std::invalid_argument("the stride between played scans must be at least 1");
+  std::vector<PlayedScan> played;
+  for (size_t index = 0; index < sequence.size(); index += stride) played.push_back({index, sequence.stamp(index)});
+  if (reverse) {
+    const double mirror = played.front().stamp + played.back().stamp;
+    std::reverse(played.begin(), played.end());
+    for (PlayedScan& scan : played) scan.stamp = mirror - scan.stamp;
+  }
+  if (max_frames > 0 && played.size() > max_frames) played.resize(max_frames);
+  return played;
+}
+
 }  // namespace elo

@@ -153,5 +153,26 @@ TEST_F(EloEvalCli, MapEntropyNeedsOnePosePerScan) {
   EXPECT_EQ(runEloEval("--est " + directory_.file("est") + " --map-entropy " + scans).exit_code, 2);
 }
 
+TEST_F(EloEvalCli, ReverseReportsHowFarAForwardAndAReverseRunFailToClose) {
+  // 10 m straight ahead; the reverse run comes back 10.05 m.
+  writeKittiPoses(directory_.file("forward.txt"), test::circle(11, 1.0, 0.0));
+  writeKittiPoses(directory_.file("reverse.txt"), test::circle(11, -1.005, 0.0));
+  const CommandResult result =
+      runEloEval("--est " + directory_.file("forward.txt") + " --reverse " + directory_.file("reverse.txt"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "forward-backward gap 0.0500 m, 0.0000 deg over 11 scans and 10.0 m (0.500 %"))
+      << result.output;
+}
+
+TEST_F(EloEvalCli, ReverseNeedsARunOverTheSameScans) {
+  writeKittiPoses(directory_.file("forward.txt"), test::circle(11, 1.0, 0.0));
+  writeKittiPoses(directory_.file("short.txt"), test::circle(10, -1.0, 0.0));
+  const CommandResult result =
+      runEloEval("--est " + directory_.file("forward.txt") + " --reverse " + directory_.file("short.txt"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_TRUE(contains(result.output, "the forward run has 11 poses and the reverse run 10")) << result.output;
+  EXPECT_EQ(runEloEval("--est " + directory_.file("est") + " --reverse " + directory_.file("short.txt")).exit_code, 2);
+}
+
 }  // namespace
 }  // namespace elo

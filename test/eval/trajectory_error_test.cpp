@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 #include "elo/eval/evaluation.hpp"
 #include "synthetic_trajectories.hpp"
@@ -54,6 +56,39 @@ TEST(TrajectoryError, AteIsTheRmsOfWhatAlignmentCannotRemove) {
 TEST(TrajectoryError, DifferentFrameCountsThrow) {
   EXPECT_THROW(relativePoseError(test::circle(5, 1, 0), test::circle(6, 1, 0)), std::invalid_argument);
   EXPECT_THROW(absoluteTrajectoryError(test::circle(5, 1, 0), test::circle(6, 1, 0)), std::invalid_argument);
+}
+
+// The reverse run of a perfect odometry: scan n-1-j in scan n-1's frame.
+std::vector<Eigen::Isometry3d> exactReverse(const std::vector<Eigen::Isometry3d>& forward) {
+  std::vector<Eigen::Isometry3d> reverse;
+  for (auto pose = forward.rbegin(); pose != forward.rend(); ++pose) reverse.push_back(forward.back().inverse() * *pose);
+  return reverse;
+}
+
+TEST(ForwardBackwardGap, APerfectRoundTripCloses) {
+  const std::vector<Eigen::Isometry3d> forward = test::circle(300, 0.8, 0.01);
+  const ForwardBackwardGap gap = forwardBackwardGap(forward, exactReverse(forward));
+  EXPECT_EQ(gap.frames, 300u);
+  EXPECT_NEAR(gap.length_m, 299 * 0.8, 1e-9);
+  EXPECT_NEAR(gap.translation_m, 0.0, 1e-9);
+  EXPECT_NEAR(gap.rotation_deg, 0.0, 1e-6);
+}
+
+TEST(ForwardBackwardGap, MeasuresWhatTheReverseRunGotWrong) {
+  // Straight ahead 99 m; the reverse run comes back 1% too far and ends turned by 0.5 deg.
+  const std::vector<Eigen::Isometry3d> forward = test::circle(100, 1.0, 0.0);
+  std::vector<Eigen::Isometry3d> reverse = test::circle(100, -1.01, 0.0);
+  reverse.back() = reverse.back() * test::yaw(0.5 * M_PI / 180.0);
+  const ForwardBackwardGap gap = forwardBackwardGap(forward, reverse);
+  EXPECT_NEAR(gap.length_m, 99.0, 1e-9);
+  EXPECT_NEAR(gap.translation_m, 0.99, 1e-9);
+  EXPECT_NEAR(gap.rotation_deg, 0.5, 1e-9);
+}
+
+TEST(ForwardBackwardGap, RunsOverDifferentScansThrow) {
+  const std::vector<Eigen::Isometry3d> forward = test::circle(10, 1.0, 0.0);
+  EXPECT_THROW(forwardBackwardGap(forward, test::circle(9, -1.0, 0.0)), std::invalid_argument);
+  EXPECT_THROW(forwardBackwardGap({}, {}), std::invalid_argument);
 }
 
 TEST(Evaluation, PoolingWeightsBySamples) {

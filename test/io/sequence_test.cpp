@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <stdexcept>
+#include <vector>
 
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
@@ -156,6 +158,39 @@ TEST(Sequence, IndexOutOfRangeThrows) {
   const Sequence sequence(directory.path().string());
   EXPECT_THROW(sequence.load(3), std::out_of_range);
   EXPECT_THROW(sequence.stamp(3), std::out_of_range);
+}
+
+// Seven flat .bin scans recorded at uneven intervals.
+Sequence writeUnevenlyTimedScans(const TempDirectory& directory) {
+  for (unsigned i = 0; i < 7; ++i) writeKittiBin(directory.file("00000" + std::to_string(i) + ".bin"), test::randomCloud(10, i));
+  writeTimes(directory.file("times.txt"), {0.0, 0.1, 0.21, 0.3, 0.42, 0.5, 0.61});
+  return Sequence(directory.path().string());
+}
+
+void expectPlayed(const std::vector<PlayedScan>& played, const std::vector<size_t>& indices,
+                  const std::vector<double>& stamps) {
+  ASSERT_EQ(played.size(), indices.size());
+  for (size_t i = 0; i < played.size(); ++i) {
+    EXPECT_EQ(played[i].index, indices[i]) << "played scan " << i;
+    EXPECT_NEAR(played[i].stamp, stamps[i], 1e-12) << "played scan " << i;
+  }
+}
+
+TEST(PlayOrder, AStrideTakesEveryKthScanAtItsRecordedTime) {
+  TempDirectory directory;
+  const Sequence sequence = writeUnevenlyTimedScans(directory);
+  expectPlayed(playOrder(sequence, 1, false), {0, 1, 2, 3, 4, 5, 6}, {0.0, 0.1, 0.21, 0.3, 0.42, 0.5, 0.61});
+  expectPlayed(playOrder(sequence, 3, false), {0, 3, 6}, {0.0, 0.3, 0.61});
+  expectPlayed(playOrder(sequence, 2, false, 2), {0, 2}, {0.0, 0.21});
+  EXPECT_THROW(playOrder(sequence, 0, false), std::invalid_argument);
+}
+
+TEST(PlayOrder, AReverseRunPlaysLastToFirstWithTimeStillAdvancingByTheRecordedIntervals) {
+  TempDirectory directory;
+  const Sequence sequence = writeUnevenlyTimedScans(directory);
+  expectPlayed(playOrder(sequence, 1, true), {6, 5, 4, 3, 2, 1, 0}, {0.0, 0.11, 0.19, 0.31, 0.4, 0.51, 0.61});
+  expectPlayed(playOrder(sequence, 3, true), {6, 3, 0}, {0.0, 0.31, 0.61});
+  expectPlayed(playOrder(sequence, 1, true, 2), {6, 5}, {0.0, 0.11});
 }
 
 TEST(Sequence, RealHdl64Drive) {

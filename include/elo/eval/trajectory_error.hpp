@@ -1,5 +1,6 @@
-// Trajectory errors beside the KITTI metric: relative pose error between consecutive frames, and
-// absolute trajectory error after a rigid alignment.
+// Trajectory errors beside the KITTI metric: relative pose error between consecutive frames, absolute
+// trajectory error after a rigid alignment, and, without ground truth, the gap between a drive run
+// forward and in reverse.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -30,5 +31,22 @@ RelativePoseError relativePoseError(const std::vector<Eigen::Isometry3d>& ground
 // relativePoseError.
 AbsoluteTrajectoryError absoluteTrajectoryError(const std::vector<Eigen::Isometry3d>& ground_truth,
                                                 const std::vector<Eigen::Isometry3d>& estimate);
+
+// How far a drive run forward and the same scans run in reverse fail to close: `forward[i]` is scan i
+// in scan 0's frame, `reverse[j]` scan n-1-j in scan n-1's frame, so forward.back() * reverse.back() is
+// the identity for a perfect odometry. It needs no ground truth. A gap g means that at least one run
+// ends g/2 or more off; a small gap proves less, since errors that flip with the direction of travel (a
+// scale error) cancel.
+struct ForwardBackwardGap {
+  size_t frames = 0;
+  double length_m = 0.0;  // the forward run's path length
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+};
+
+// Throws std::invalid_argument naming both counts when the runs have different lengths, and for empty
+// runs.
+ForwardBackwardGap forwardBackwardGap(const std::vector<Eigen::Isometry3d>& forward,
+                                      const std::vector<Eigen::Isometry3d>& reverse);
 
 }  // namespace elo

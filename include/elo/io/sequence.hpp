@@ -51,4 +51,17 @@ class Sequence {
   std::vector<Eigen::Isometry3d> ground_truth_;
 };
 
+// One scan of a run over a sequence: which scan, and the stamp the run gives it.
+struct PlayedScan {
+  size_t index;
+  double stamp;
+};
+
+// The scans a run plays, in order: every `stride`-th scan from the first (a faster drive, or dropped
+// frames) and, with `reverse`, last to first; at most `max_frames` of them (0: all). A reverse run drives
+// the route backwards rather than back in time: its stamps are mirrored about the played span, so they
+// still advance by the recorded intervals. Per-point times within a scan are not mirrored. Throws
+// std::invalid_argument for a stride of 0.
+std::vector<PlayedScan> playOrder(const Sequence& sequence, size_t stride, bool reverse, size_t max_frames = 0);
+
 }  // namespace elo
