@@ -6,7 +6,7 @@
 #   tools/demo.sh BUILD_DIR [SHARED_DATA_DIR]
 # Environment: DEMO_FRAMES (scans to simulate, default 1050: the whole drive; 60 make a short run),
 # DEMO_OUTPUT (default BUILD_DIR/demo), DEMO_KEEP=1 (keep the scans and the bag, which are otherwise
-# removed at the end: together about 3.5 GB for the whole drive).
+# removed at the end: together 3.6 GB for the whole drive).
 # Writes DEMO_OUTPUT/: poses.txt (elo_run), timing.csv, trajectory.png, poses_ros.txt (the node),
 # roslaunch.log, sequence/ (times, ground truth, calibration; the scans with DEMO_KEEP=1).
 # Exits non-zero, naming the step and its log, when any step fails.
@@ -20,6 +20,11 @@ for tool in elo_sim elo_run elo_eval kitti_to_bag; do
 done
 [[ "$frames" =~ ^[1-9][0-9]*$ ]] || { echo "demo: DEMO_FRAMES must be a positive integer, got '$frames'" >&2; exit 2; }
 out=${DEMO_OUTPUT:-$build/demo}
+# Replaces an earlier demo's output, and nothing else.
+if [ -n "$(ls -A "$out" 2>/dev/null)" ] && [ ! -e "$out/elo_sim.log" ] && [ ! -e "$out/poses.txt" ]; then
+  echo "demo: $out holds files that are not a demo's; name another DEMO_OUTPUT" >&2
+  exit 2
+fi
 rm -rf "$out"
 mkdir -p "$out"
 # Absolute paths from here on: roslaunch runs its nodes in ROS_HOME, not here.
