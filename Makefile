@@ -83,7 +83,8 @@ fuzz: deps
 bench: build
 	tools/bench.sh $(BUILD) $(SHARED_DATA)
 
-# The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth.
+# The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth, then
+# replayed from a bag through the ROS node. DEMO_FRAMES=60 makes it short; see tools/demo.sh.
 demo: build
 	tools/demo.sh $(BUILD) $(SHARED_DATA)
 

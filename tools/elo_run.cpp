@@ -10,6 +10,7 @@
 #include <iostream>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ constexpr char kUsage[] = R"(usage: elo_run --input DIR --output POSES [options]
 Runs ELO odometry over DIR (KITTI layout: DIR/velodyne/*.bin with optional times.txt and calib.txt;
 or a directory of .pcd / .bin scans) and writes one KITTI pose line per scan (sensor frame, scan 0 at
 the origin). With DIR/calib.txt it also writes the camera-frame trajectory the KITTI devkit scores.
+A scan that cannot be read (missing, truncated, malformed) is skipped and counted like a scan the
+odometry cannot use: its pose line repeats the last pose, and the summary says how many and why. A run
+that fails part-way still writes the poses of the scans before the failure.
 
 options:
   --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config)
@@ -42,6 +46,8 @@ options:
   --timing CSV         per-frame stage times, iterations, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
+  --strict             stop at the first scan that cannot be read and exit 1 (after writing the
+                       poses of the scans before it), instead of skipping it
   --quiet              no progress bar
   --dump-config        print the effective configuration as YAML and exit
   --help
@@ -58,6 +64,7 @@ struct Options {
   size_t max_frames = 0;
   size_t stride = 1;
   bool reverse = false;
+  bool strict = false;
   bool quiet = false;
   bool dump_config = false;
 };
@@ -100,6 +107,8 @@ Options parseArguments(int argc, char** argv) {
       options.tum_output = arguments.value();
     } else if (arguments.is("--camera-output")) {
       options.camera_output = arguments.value();
+    } else if (arguments.is("--strict")) {
+      options.strict = true;
     } else if (arguments.is("--quiet")) {
       options.quiet = true;
     } else if (arguments.is("--dump-config")) {
@@ -150,6 +159,25 @@ StageSummary summarise(std::vector<double> values) {
   return summary;
 }
 
+// A scan read from disk, or why it could not be read: the counted reason and the reader's message (a
+// missing, truncated or malformed file).
+struct ScanRead {
+  std::optional<elo::PointCloud> cloud;
+  std::string reason;
+  std::string detail;
+};
+
+ScanRead readScan(const elo::Sequence& sequence, size_t index, size_t& non_finite_points) {
+  try {
+    size_t non_finite = 0;
+    elo::PointCloud cloud = sequence.load(index, &non_finite);
+    non_finite_points += non_finite;
+    return {std::move(cloud), "", ""};
+  } catch (const elo::IoError& error) {
+    return {std::nullopt, "scan file unreadable", error.what()};
+  }
+}
+
 class Report {
  public:
   // `upload_ms`: the part of the projection that copied the scan to a device (0 on the CPU backend).
@@ -162,10 +190,19 @@ class Report {
     model_update_.push_back(result.times.model_update);
     total_.push_back(result.times.total);
   }
+  void addUnreadable(const std::string& reason) { ++unreadable_[reason]; }
 
-  void print(elo::Odometry& odometry, size_t scans, double wall_seconds) const {
+  void print(elo::Odometry& odometry, size_t scans, size_t non_finite_points, double wall_seconds) const {
+    if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
     std::printf("\nframes: %zu scans, %zu processed", scans, odometry.processedCount());
-    for (const auto& [reason, count] : odometry.skippedCounts()) std::printf(", %zu skipped (%s)", count, reason.c_str());
+    size_t skipped = 0;
+    for (const auto* counts : {&unreadable_, &odometry.skippedCounts()}) {
+      for (const auto& [reason, count] : *counts) {
+        std::printf(", %zu skipped (%s)", count, reason.c_str());
+        skipped += count;
+      }
+    }
+    if (skipped > 0) std::printf("; a skipped scan's pose line repeats the last pose");
     if (odometry.degenerateCount() > 0) {
       std::printf(", %zu degenerate (the motion prior kept along what the scan did not constrain)",
                   odometry.degenerateCount());
@@ -196,6 +233,7 @@ class Report {
 
  private:
   std::vector<double> projection_, upload_, features_, registration_, model_update_, total_;
+  std::map<std::string, size_t> unreadable_;
 };
 
 void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {
@@ -214,6 +252,84 @@ void showProgress(size_t done, size_t total) {
   if (done == total) std::fprintf(stderr, "\n");
 }
 
+// One pose per played scan, at the scan's stamp: what the run writes.
+struct Trajectory {
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<double> stamps;
+};
+
+void writeTrajectory(const Options& options, const elo::Sequence& sequence, const Trajectory& trajectory) {
+  elo::writeKittiPoses(options.output, trajectory.poses);
+  if (sequence.hasCalibration()) {
+    elo::writeKittiPoses(cameraOutputPath(options), elo::lidarToCamera(trajectory.poses, sequence.calibration()));
+  }
+  if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, trajectory.stamps, trajectory.poses);
+}
+
+// Reads and processes every played scan, appending its pose to `trajectory` as it goes, so that the
+// caller can write the poses computed before any failure. A scan that cannot be read is skipped (its
+// line repeats the last pose) or, with --strict, ends the run with an IoError.
+class ScanLoop {
+ public:
+  ScanLoop(const Options& options, const elo::Sequence& sequence, elo::Odometry& odometry)
+      : options_(options), sequence_(sequence), odometry_(odometry) {
+    if (options.timing_csv.empty()) return;
+    timing_.open(options.timing_csv);
+    if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
+    timing_ << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
+               "iterations,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
+  }
+
+  void run(const std::vector<elo::PlayedScan>& played, Trajectory& trajectory) {
+    const bool progress = !options_.quiet && isatty(STDERR_FILENO);
+    for (size_t i = 0; i < played.size(); ++i) {
+      const elo::FrameResult result = processScan(played[i]);
+      trajectory.poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned
+      trajectory.stamps.push_back(played[i].stamp);
+      if (timing_.is_open()) writeTimingRow(timing_, i, played[i].stamp, result);
+      if (progress) showProgress(i + 1, played.size());
+    }
+  }
+
+  const Report& report() const { return report_; }
+  size_t nonFinitePoints() const { return non_finite_points_; }
+
+ private:
+  elo::FrameResult processScan(const elo::PlayedScan& played) {
+    const size_t scan = played.index;
+    ScanRead read = readScan(sequence_, scan, non_finite_points_);
+    if (!read.cloud) return skipUnreadable(scan, read);
+    read.cloud->stamp = played.stamp;
+    const elo::FrameResult result = odometry_.process(*read.cloud);
+    if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
+    if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
+    if (result.gap_restart) {
+      std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", scan);
+    }
+    report_.add(result, odometry_.backend().lastUploadMilliseconds());
+    return result;
+  }
+
+  elo::FrameResult skipUnreadable(size_t scan, const ScanRead& read) {
+    if (options_.strict) {
+      throw elo::IoError("scan " + std::to_string(scan) + ": " + read.detail + " (--strict stops at a scan that cannot be read)");
+    }
+    std::fprintf(stderr, "\nscan %zu skipped: %s: %s\n", scan, read.reason.c_str(), read.detail.c_str());
+    report_.addUnreadable(read.reason);
+    elo::FrameResult skipped;
+    skipped.skip_reason = read.reason;
+    skipped.pose = odometry_.pose();
+    return skipped;
+  }
+
+  const Options& options_;
+  const elo::Sequence& sequence_;
+  elo::Odometry& odometry_;
+  std::ofstream timing_;
+  Report report_;
+  size_t non_finite_points_ = 0;
+};
+
 int run(const Options& options) {
   const elo::Config config = loadConfig(options);
   if (options.dump_config) {
@@ -222,49 +338,22 @@ int run(const Options& options) {
   }
   const elo::Sequence sequence(options.input);
   const std::vector<elo::PlayedScan> played = elo::playOrder(sequence, options.stride, options.reverse, options.max_frames);
-  const size_t scans = played.size();
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
-  std::ofstream timing;
-  if (!options.timing_csv.empty()) {
-    timing.open(options.timing_csv);
-    if (!timing) throw elo::IoError("cannot write " + options.timing_csv);
-    timing << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
-              "iterations,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
-  }
-  const bool progress = !options.quiet && isatty(STDERR_FILENO);
-  std::vector<Eigen::Isometry3d> poses;
-  std::vector<double> stamps;
-  Report report;
-  size_t non_finite_points = 0;
+  ScanLoop loop(options, sequence, odometry);
+  Trajectory trajectory;
   const auto start = std::chrono::steady_clock::now();
-  for (size_t i = 0; i < scans; ++i) {
-    size_t non_finite = 0;
-    elo::PointCloud cloud = sequence.load(played[i].index, &non_finite);
-    cloud.stamp = played[i].stamp;
-    non_finite_points += non_finite;
-    const elo::FrameResult result = odometry.process(cloud);
-    const size_t scan = played[i].index;
-    if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
-    if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
-    if (result.gap_restart) {
-      std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", scan);
-    }
-    poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned with scans
-    stamps.push_back(cloud.stamp);
-    report.add(result, odometry.backend().lastUploadMilliseconds());
-    if (timing) writeTimingRow(timing, i, cloud.stamp, result);
-    if (progress) showProgress(i + 1, scans);
+  try {
+    loop.run(played, trajectory);
+  } catch (const std::exception&) {
+    writeTrajectory(options, sequence, trajectory);
+    std::fprintf(stderr, "\nelo_run: stopped after %zu of %zu scans; their poses are in %s\n", trajectory.poses.size(),
+                 played.size(), options.output.c_str());
+    throw;
   }
   const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  elo::writeKittiPoses(options.output, poses);
-  if (sequence.hasCalibration()) {
-    elo::writeKittiPoses(cameraOutputPath(options), elo::lidarToCamera(poses, sequence.calibration()));
-  }
-  if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, stamps, poses);
-  if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
-  report.print(odometry, scans, wall_seconds);
+  writeTrajectory(options, sequence, trajectory);
+  loop.report().print(odometry, played.size(), loop.nonFinitePoints(), wall_seconds);
   return 0;
 }
 

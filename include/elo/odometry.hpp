@@ -42,7 +42,7 @@ class Odometry {
   explicit Odometry(const Config& config);
 
   // Processes one sweep. A scan that cannot be used (empty, too few valid points, a stamp that is not
-  // finite or repeats the last one) is skipped, counted under its reason and leaves the state as it was.
+  // finite or repeats the last one to the nanosecond) is skipped, counted under its reason and leaves the state as it was.
   // A stamp before the last one resets (see reset()); one more than model.time_window after it restarts
   // the model at the current pose (FrameResult::gap_restart).
   FrameResult process(const PointCloud& cloud);
@@ -73,6 +73,11 @@ class Odometry {
   FrameResult skip(const std::string& reason);
   // Forgets the model and the motion but keeps the pose: the next scan continues the trajectory from it.
   void restartModel();
+  // `stamp` - the first scan's stamp, in whole nanoseconds as ROS stamps count time. The intervals the
+  // motion prior and the model's time window see are differences of these: so a drive stamped from 0
+  // (times.txt) and the same drive stamped from a later start (a bag's ros::Time stamps) give the same
+  // intervals to the bit, and the same poses, where the raw differences would differ in their last bits.
+  double secondsSinceFirst(double stamp) const;
   // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
   void followTimeline(double stamp, FrameResult& result);
 
@@ -84,6 +89,7 @@ class Odometry {
   bool started_ = false;
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
+  double last_since_first_ = 0.0;  // secondsSinceFirst(last_stamp_)
   size_t processed_ = 0;
   size_t degenerate_ = 0;
   std::map<std::string, size_t> skipped_;

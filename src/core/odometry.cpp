@@ -46,6 +46,8 @@ void Odometry::followTimeline(double stamp, FrameResult& result) {
   }
 }
 
+double Odometry::secondsSinceFirst(double stamp) const { return std::round((stamp - first_stamp_) * 1e9) / 1e9; }
+
 size_t Odometry::minOccupiedPixels() const {
   return static_cast<size_t>(config_.normals.min_window_height) * static_cast<size_t>(config_.sensor.image_width);
 }
@@ -61,14 +63,15 @@ FrameResult Odometry::skip(const std::string& reason) {
 FrameResult Odometry::process(const PointCloud& cloud) {
   if (cloud.points.empty()) return skip("empty cloud");
   if (!std::isfinite(cloud.stamp)) return skip("stamp not finite");
-  if (started_ && cloud.stamp == last_stamp_) return skip("duplicate stamp");
+  if (started_ && secondsSinceFirst(cloud.stamp) == last_since_first_) return skip("duplicate stamp");
   FrameResult result;
   followTimeline(cloud.stamp, result);
   if (!started_) first_stamp_ = cloud.stamp;
+  const double since_first = secondsSinceFirst(cloud.stamp);
 
   const auto frame_start = Clock::now();
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
-  const float relative_stamp = static_cast<float>(cloud.stamp - first_stamp_);
+  const float relative_stamp = static_cast<float>(since_first);
 
   auto stage_start = Clock::now();
   const size_t occupied = backend_->projectScan(cloud, relative_stamp);
@@ -88,7 +91,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
-    const double dt = cloud.stamp - last_stamp_;
+    const double dt = since_first - last_since_first_;
     stage_start = Clock::now();
     result.registration = registerScan(*backend_, motion_.predict(dt), motion_.informed(), config_.registration);
     result.times.registration = millisecondsSince(stage_start);
@@ -109,6 +112,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
 
   started_ = true;
   last_stamp_ = cloud.stamp;
+  last_since_first_ = since_first;
   ++processed_;
   result.processed = true;
   result.pose = pose_;

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,8 +16,18 @@
 namespace elo {
 namespace {
 
-constexpr int kPanelWidthPx = 640;
-constexpr int kPanelHeightPx = 600;
+// The canvas: two error panels side by side, and the top view above them across the whole width.
+constexpr int kCanvasWidthPx = 1280;
+constexpr int kErrorPanelHeightPx = 480;
+constexpr int kTitleHeightPx = 30;
+// Pixels around the top view's plot area: tic labels, axis labels and the panel's title.
+constexpr int kTopViewMarginWidthPx = 140;
+constexpr int kTopViewMarginHeightPx = 110;
+constexpr int kMinTopViewHeightPx = 360;
+constexpr int kMaxTopViewHeightPx = 900;
+constexpr double kMinTopViewAspect = 0.3;  // the narrower range over the wider
+constexpr double kTopViewMargin = 0.04;    // of each range, on either side
+constexpr int kKeyHeightPx = 40;           // above the trajectories
 
 bool gnuplotInstalled() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
@@ -61,22 +73,27 @@ void writeTrajectoryBlock(std::ostream& script, const std::string& block, const 
 }
 
 void writeTrajectoryPanel(std::ostream& script, const std::vector<Eigen::Isometry3d>& ground_truth,
-                          const std::vector<Eigen::Isometry3d>& estimate, TopView view) {
-  const std::pair<int, int> axes = topViewAxes(view, ground_truth);
+                          const std::vector<Eigen::Isometry3d>& estimate, const TopViewFrame& frame) {
   const std::array<const char*, 3> axis_names = {"x", "y", "z"};
-  writeTrajectoryBlock(script, "$gt", ground_truth, axes);
-  writeTrajectoryBlock(script, "$est", estimate, axes);
+  writeTrajectoryBlock(script, "$gt", ground_truth, frame.axes);
+  writeTrajectoryBlock(script, "$est", estimate, frame.axes);
   script << "set size ratio -1\n"
-         << "set key below\n"
-         << "set xlabel '" << axis_names[axes.first] << " (m)'\n"
-         << "set ylabel '" << axis_names[axes.second] << " (m)'\n"
+         << "set key inside top right horizontal opaque box\n"
+         << "set xrange [" << frame.low.x() << ":" << frame.high.x() << "]\n"
+         << "set yrange [" << frame.low.y() << ":" << frame.high.y() << "]\n"
+         << "set xlabel '" << axis_names[frame.axes.first] << " (m)'\n"
+         << "set ylabel '" << axis_names[frame.axes.second] << " (m)'\n"
          << "set title 'trajectory (top view)'\n"
-         << "plot $gt using 1:2 with lines lw 2 lc rgb '#d62728' title 'ground truth', "
-            "$est using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'estimate'\n"
-         << "set size noratio\n";
+         // The ground truth drawn wider, under the estimate: it still shows where the two coincide.
+         << "plot $gt using 1:2 with lines lw 5 lc rgb '#d62728' title 'ground truth', "
+            "$est using 1:2 with lines lw 1.5 lc rgb '#1f77b4' title 'estimate'\n"
+         << "set size noratio\n"
+         << "set autoscale\n"
+         << "unset key\n";  // the error panels plot one curve each
 }
 
-void writeDriftPanels(std::ostream& script, const std::vector<LengthDriftError>& drift_by_length) {
+// Writes the segment errors as the data block both error panels plot, and the first of them.
+void writeTranslationDriftPanel(std::ostream& script, const std::vector<LengthDriftError>& drift_by_length) {
   script << "$drift << EOD\n";
   for (const LengthDriftError& entry : drift_by_length) {
     script << entry.length << ' ' << entry.error.t_rel_percent << ' ' << entry.error.r_rel_deg_per_100m << '\n';
@@ -86,10 +103,21 @@ void writeDriftPanels(std::ostream& script, const std::vector<LengthDriftError>&
          << "set yrange [0:*]\n"
          << "set ylabel 'translation error (%)'\n"
          << "set title 't_rel'\n"
-         << "plot $drift using 1:2 with linespoints lw 2 pt 7 lc rgb '#1f77b4' notitle\n"
-         << "set ylabel 'rotation error (deg/100 m)'\n"
+         << "plot $drift using 1:2 with linespoints lw 2 pt 7 lc rgb '#1f77b4' notitle\n";
+}
+
+void writeRotationDriftPanel(std::ostream& script) {
+  script << "set ylabel 'rotation error (deg/100 m)'\n"
          << "set title 'r_rel'\n"
          << "plot $drift using 1:3 with linespoints lw 2 pt 7 lc rgb '#1f77b4' notitle\n";
+}
+
+// Places a panel at (`x`, `y`) pixels from the canvas's top left, `width` by `height` pixels.
+void placePanel(std::ostream& script, int x, int y, int width, int height, int canvas_height) {
+  script << "set origin " << static_cast<double>(x) / kCanvasWidthPx << ","
+         << static_cast<double>(canvas_height - y - height) / canvas_height << "\n"
+         << "set size " << static_cast<double>(width) / kCanvasWidthPx << ","
+         << static_cast<double>(height) / canvas_height << "\n";
 }
 
 std::string gnuplotScript(const std::string& png_path, const std::vector<Eigen::Isometry3d>& ground_truth,
@@ -97,8 +125,10 @@ std::string gnuplotScript(const std::string& png_path, const std::vector<Eigen::
                           const std::vector<LengthDriftError>& drift_by_length, TopView view, const std::string& title) {
   const bool has_trajectory = !ground_truth.empty();
   const bool has_drift = !drift_by_length.empty();
-  const int panels = (has_trajectory ? 1 : 0) + (has_drift ? 2 : 0);
-  const std::string size = std::to_string(panels * kPanelWidthPx) + "," + std::to_string(kPanelHeightPx);
+  const TopViewFrame frame = has_trajectory ? topViewFrame(ground_truth, estimate, view) : TopViewFrame{};
+  const int top_view_height = has_trajectory ? frame.height_px : 0;
+  const int canvas_height = kTitleHeightPx + top_view_height + (has_drift ? kErrorPanelHeightPx : 0);
+  const std::string size = std::to_string(kCanvasWidthPx) + "," + std::to_string(canvas_height);
   std::ostringstream script;
   script.precision(10);
   // pngcairo draws better; the libgd `png` terminal is the fallback of a gnuplot built without cairo.
@@ -109,12 +139,17 @@ std::string gnuplotScript(const std::string& png_path, const std::vector<Eigen::
          << "}\n"
          << "set output " << gnuplotString(png_path) << "\n"
          << "set grid\n"
-         << "set multiplot layout 1," << panels << " title " << gnuplotString(title) << "\n";
+         << "set multiplot title " << gnuplotString(title) << "\n";
   if (has_trajectory) {
-    writeTrajectoryPanel(script, ground_truth, estimate, view);
+    placePanel(script, 0, kTitleHeightPx, kCanvasWidthPx, top_view_height, canvas_height);
+    writeTrajectoryPanel(script, ground_truth, estimate, frame);
   }
   if (has_drift) {
-    writeDriftPanels(script, drift_by_length);
+    const int top = kTitleHeightPx + top_view_height;
+    placePanel(script, 0, top, kCanvasWidthPx / 2, kErrorPanelHeightPx, canvas_height);
+    writeTranslationDriftPanel(script, drift_by_length);
+    placePanel(script, kCanvasWidthPx / 2, top, kCanvasWidthPx / 2, kErrorPanelHeightPx, canvas_height);
+    writeRotationDriftPanel(script);
   }
   script << "unset multiplot\n";
   return script.str();
@@ -137,6 +172,35 @@ bool runGnuplot(const std::string& script) {
 }
 
 }  // namespace
+
+TopViewFrame topViewFrame(const std::vector<Eigen::Isometry3d>& ground_truth,
+                          const std::vector<Eigen::Isometry3d>& estimate, TopView view) {
+  TopViewFrame frame;
+  frame.axes = topViewAxes(view, ground_truth);
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector2d high = -low;
+  for (const auto* poses : {&ground_truth, &estimate}) {
+    for (const Eigen::Isometry3d& pose : *poses) {
+      const Eigen::Vector2d point(pose.translation()[frame.axes.first], pose.translation()[frame.axes.second]);
+      low = low.cwiseMin(point);
+      high = high.cwiseMax(point);
+    }
+  }
+  Eigen::Vector2d span = (high - low).cwiseMax(1.0);  // a sensor standing still gets a metre
+  span = span.cwiseMax(kMinTopViewAspect * span.maxCoeff());
+  span *= 1.0 + 2.0 * kTopViewMargin;
+  // One scale (metres per pixel) for both axes, as large as the width or the tallest panel needs.
+  const int plot_width = kCanvasWidthPx - kTopViewMarginWidthPx;
+  const int max_plot_height = kMaxTopViewHeightPx - kTopViewMarginHeightPx - kKeyHeightPx;
+  const double scale = std::max(span.x() / plot_width, span.y() / max_plot_height);
+  const Eigen::Vector2d center = (low + high) / 2.0;
+  frame.low = center - span / 2.0;
+  frame.high = center + span / 2.0;
+  frame.high.y() += kKeyHeightPx * scale;
+  const int plot_height = static_cast<int>(std::lround(span.y() / scale)) + kKeyHeightPx;
+  frame.height_px = std::max(kMinTopViewHeightPx, plot_height + kTopViewMarginHeightPx);
+  return frame;
+}
 
 bool plotEvaluation(const std::string& png_path, const std::vector<Eigen::Isometry3d>& ground_truth,
                     const std::vector<Eigen::Isometry3d>& estimate,

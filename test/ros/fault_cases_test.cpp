@@ -189,7 +189,7 @@ TEST(NodeletFaults, EveryCloudIsTrackedOrCountedWithItsReason) {
   elo::Config config;
   elo::loadConfigYaml(std::string(ELO_SOURCE_DIR) + "/config/hdl64.yaml", config);
   config.runtime.threads = 2;
-  const std::vector<Eigen::Isometry3d> expected = runInProcess(config, sequence, clouds);
+  const std::vector<Eigen::Isometry3d> expected = runInProcess(config, sequence, clouds.size());
   const size_t first_pass = feed.processed_scans.size() - 5;
   for (size_t i = 0; i < odometry.size(); ++i) {
     const size_t scan = feed.processed_scans[i];

@@ -94,17 +94,15 @@ inline bool waitForConnections(const ros::Publisher& publisher, OdometryRecorder
   return false;
 }
 
-// The scans of `sequence` with the stamps their bag messages carry: the nodelet sees the stamps after
-// their round trip through ros::Time, and the core's motion prior uses them.
+// What elo_run computes over the first `scans` scans of `sequence`: each with its own stamp (times.txt).
+// The nodelet sees the stamps of the bag's messages instead (kitti_to_bag's start time added, rounded to
+// nanoseconds by ros::Time) and must give the same poses, the core counting time in whole nanoseconds
+// since the first scan.
 inline std::vector<Eigen::Isometry3d> runInProcess(const elo::Config& config, const elo::Sequence& sequence,
-                                                   const CloudMessages& clouds) {
+                                                   size_t scans) {
   elo::Odometry odometry(config);
   std::vector<Eigen::Isometry3d> poses;
-  for (size_t i = 0; i < clouds.size(); ++i) {
-    elo::PointCloud cloud = sequence.load(i);
-    cloud.stamp = clouds[i]->header.stamp.toSec();
-    poses.push_back(odometry.process(cloud).pose);
-  }
+  for (size_t i = 0; i < scans; ++i) poses.push_back(odometry.process(sequence.load(i)).pose);
   return poses;
 }
 

@@ -1,0 +1,170 @@
+// elo_run over a simulated sequence with scans it cannot read: a truncated or malformed scan is skipped,
+// counted by reason and its pose line repeats the last pose, so that the lines still match the scans;
+// --strict stops at such a scan with a non-zero exit, after writing the poses of the scans before it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "../io/temp_directory.hpp"
+#include "elo/io/pcd.hpp"
+#include "elo/io/sequence.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr size_t kScans = 6;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandResult runCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  char buffer[4096];
+  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+bool contains(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
+
+std::vector<std::string> lines(const std::string& path) {
+  std::vector<std::string> result;
+  std::ifstream stream(path);
+  for (std::string line; std::getline(stream, line);) result.push_back(line);
+  return result;
+}
+
+std::string scanPath(const fs::path& sequence, size_t index, const char* extension = ".bin") {
+  char name[16];
+  std::snprintf(name, sizeof(name), "%06zu", index);
+  return (sequence / "velodyne" / (name + std::string(extension))).string();
+}
+
+// Cuts a scan file short in the middle of a point, as an interrupted copy leaves it.
+void truncate(const std::string& path) { fs::resize_file(path, fs::file_size(path) / 2 + 3); }
+
+class EloRunCli : public testing::Test {
+ protected:
+  // One simulated drive for the whole suite; each test corrupts a copy of it.
+  static void SetUpTestSuite() {
+    drive_ = new elo::test::TempDirectory;
+    const CommandResult simulated =
+        runCommand(std::string(ELO_SIM_TOOL) + " --world urban --trajectory straight --sensor hdl64 --seed 3 --frames " +
+                   std::to_string(kScans) + " --threads 2 --output " + drive_->file("sequence"));
+    ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+    const CommandResult intact = runEloRunOn(drive_->file("sequence"), drive_->file("intact.txt"));
+    ASSERT_EQ(intact.exit_code, 0) << intact.output;
+    intact_poses_ = lines(drive_->file("intact.txt"));
+    ASSERT_EQ(intact_poses_.size(), kScans);
+  }
+  static void TearDownTestSuite() { delete drive_; }
+
+  static CommandResult runEloRunOn(const std::string& sequence, const std::string& poses,
+                                   const std::string& options = "") {
+    return runCommand(std::string(ELO_RUN_TOOL) + " --input " + sequence + " --output " + poses + " --config " +
+                      ELO_SOURCE_DIR + "/config/hdl64.yaml --threads 2 --quiet " + options);
+  }
+
+  void SetUp() override {
+    sequence_ = directory_.path() / "sequence";
+    fs::copy(drive_->path() / "sequence", sequence_, fs::copy_options::recursive);
+  }
+
+  CommandResult runEloRun(const std::string& options = "") const {
+    return runEloRunOn(sequence_.string(), poses(), options);
+  }
+  std::string poses() const { return directory_.file("poses.txt"); }
+
+  static elo::test::TempDirectory* drive_;
+  static std::vector<std::string> intact_poses_;
+  elo::test::TempDirectory directory_;
+  fs::path sequence_;
+};
+
+elo::test::TempDirectory* EloRunCli::drive_ = nullptr;
+std::vector<std::string> EloRunCli::intact_poses_;
+
+TEST_F(EloRunCli, HelpDocumentsStrict) {
+  const CommandResult result = runCommand(std::string(ELO_RUN_TOOL) + " --help");
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_TRUE(contains(result.output, "--strict")) << result.output;
+}
+
+TEST_F(EloRunCli, TruncatedLastScanIsSkippedAndRepeatsTheLastPose) {
+  truncate(scanPath(sequence_, kScans - 1));
+  const CommandResult result = runEloRun();
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans) << "one pose line per scan";
+  for (size_t i = 0; i + 1 < kScans; ++i) EXPECT_EQ(written[i], intact_poses_[i]) << "scan " << i;
+  EXPECT_EQ(written[kScans - 1], written[kScans - 2]);
+  EXPECT_NE(written[kScans - 1], intact_poses_[kScans - 1]);
+  EXPECT_TRUE(contains(result.output, "scan 5 skipped: scan file unreadable")) << result.output;
+  EXPECT_TRUE(contains(result.output, "5 processed, 1 skipped (scan file unreadable)")) << result.output;
+  EXPECT_TRUE(contains(result.output, "repeats the last pose")) << result.output;
+}
+
+TEST_F(EloRunCli, UnreadableScansInTheMiddleAndAtTheEndAreCountedTogether) {
+  std::ofstream(scanPath(sequence_, 2), std::ios::trunc) << "not a scan";
+  truncate(scanPath(sequence_, kScans - 1));
+  const CommandResult result = runEloRun("--tum " + directory_.file("poses.tum"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans);
+  EXPECT_EQ(written[0], intact_poses_[0]);
+  EXPECT_EQ(written[1], intact_poses_[1]);
+  EXPECT_EQ(written[2], written[1]) << "the unreadable scan repeats the last pose";
+  EXPECT_NE(written[3], written[2]) << "the odometry goes on after the unreadable scan";
+  EXPECT_EQ(written[5], written[4]);
+  EXPECT_EQ(lines(directory_.file("poses.tum")).size(), kScans);
+  EXPECT_TRUE(contains(result.output, "4 processed, 2 skipped (scan file unreadable)")) << result.output;
+}
+
+TEST_F(EloRunCli, MalformedPcdScanIsSkipped) {
+  // The same drive as a directory of PCD scans, the fourth with a header that stops short.
+  const fs::path pcd_sequence = directory_.path() / "pcd";
+  fs::create_directories(pcd_sequence);
+  const elo::Sequence bins(sequence_.string());
+  for (size_t i = 0; i < kScans; ++i) {
+    const std::string name = fs::path(scanPath(pcd_sequence, i, ".pcd")).filename().string();
+    elo::writePcd((pcd_sequence / name).string(), bins.load(i));
+  }
+  fs::copy_file(sequence_ / "times.txt", pcd_sequence / "times.txt");
+  std::ofstream(pcd_sequence / "000003.pcd", std::ios::trunc) << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\n";
+  const CommandResult result = runEloRunOn(pcd_sequence.string(), poses());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans);
+  EXPECT_EQ(written[3], written[2]);
+  EXPECT_TRUE(contains(result.output, "scan 3 skipped: scan file unreadable")) << result.output;
+  EXPECT_TRUE(contains(result.output, "1 skipped (scan file unreadable)")) << result.output;
+}
+
+TEST_F(EloRunCli, StrictStopsAtTheFirstUnreadableScanAndKeepsThePosesBeforeIt) {
+  truncate(scanPath(sequence_, kScans - 1));
+  const CommandResult result = runEloRun("--strict");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans - 1) << "the poses computed before the unreadable scan";
+  for (size_t i = 0; i < written.size(); ++i) EXPECT_EQ(written[i], intact_poses_[i]) << "scan " << i;
+  EXPECT_TRUE(contains(result.output, "scan 5: ")) << result.output;
+  EXPECT_TRUE(contains(result.output, "--strict")) << result.output;
+}
+
+TEST_F(EloRunCli, StrictRunOverGoodScansSucceeds) {
+  const CommandResult result = runEloRun("--strict");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(lines(poses()), intact_poses_);
+}
+
+}  // namespace
