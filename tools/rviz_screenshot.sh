@@ -17,9 +17,10 @@ done
 work=$(mktemp -d)
 pids=()
 cleanup() {
-  # roslaunch takes its nodes down on SIGINT; Xvfb goes last, once rviz has let go of it.
+  # SIGTERM: a background job of a script ignores SIGINT. roslaunch takes its nodes down; Xvfb goes
+  # last, once rviz has let go of it.
   for ((i = ${#pids[@]} - 1; i >= 0; i--)); do
-    kill -INT "${pids[i]}" 2>/dev/null || true
+    kill -TERM "${pids[i]}" 2>/dev/null || true
     wait "${pids[i]}" 2>/dev/null || true
   done
   rm -rf "$work"
@@ -36,7 +37,7 @@ bag=$(realpath "$bag")  # roslaunch runs the player in ~/.ros
 
 # A screen of rviz's window size (rviz/elo.rviz); Xvfb picks a free display number and writes its frame
 # buffer as an XWD file into $work.
-Xvfb -displayfd 3 -screen 0 1400x900x24 -fbdir "$work" -nolisten tcp 3>"$work/display" 2>"$work/xvfb.log" &
+Xvfb -displayfd 3 -screen 0 1400x900x24 -fbdir "$work" -nolisten tcp -nocursor 3>"$work/display" 2>"$work/xvfb.log" &
 pids+=($!)
 for _ in $(seq 50); do [ -s "$work/display" ] && break; sleep 0.1; done
 [ -s "$work/display" ] || { echo "rviz_screenshot: Xvfb did not start:" >&2; cat "$work/xvfb.log" >&2; exit 1; }
@@ -44,7 +45,7 @@ DISPLAY=":$(cat "$work/display")"
 export DISPLAY
 
 # A master of our own on a free port, so that other ROS graphs on this machine are left alone.
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
+port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://localhost:$port"
 set +u  # catkin's generated setup scripts read unset variables
 # shellcheck disable=SC1091
@@ -57,18 +58,28 @@ pids+=($!)
 
 # The odometry has caught up when it publishes the pose of the bag's last scan (the waiter subscribes
 # before the player starts, so it sees every pose); then rviz gets a moment to draw it.
-python3 - "$bag" <<'EOF_PY' &
+# Debian's python3, which has rospy, whatever python3 comes first on PATH.
+/usr/bin/python3 - "$bag" <<'EOF_PY' &
+import struct
 import sys
 import threading
 import rosbag
 import rospy
-from nav_msgs.msg import Odometry
 
 last_scan = rosbag.Bag(sys.argv[1]).get_end_time()
 caught_up = threading.Event()
+
+
+def on_odometry(message):
+    # A stamped message starts with its header: seq, then the stamp's secs and nsecs (little-endian).
+    # Read raw, so that no message package beyond rospy's own is needed.
+    secs, nsecs = struct.unpack_from("<II", message._buff, 4)
+    if secs + nsecs * 1e-9 >= last_scan - 0.05:
+        caught_up.set()
+
+
 rospy.init_node("rviz_screenshot_wait", anonymous=True, disable_signals=True)
-rospy.Subscriber("/elo/odom", Odometry,
-                 lambda odometry: odometry.header.stamp.to_sec() >= last_scan - 0.05 and caught_up.set())
+rospy.Subscriber("/elo/odom", rospy.AnyMsg, on_odometry)
 if not caught_up.wait(timeout=900):  # wall seconds
     sys.exit("rviz_screenshot: the odometry did not reach the bag's last scan within 15 minutes")
 EOF_PY
