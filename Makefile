@@ -2,7 +2,8 @@
 # odometry on a simulated drive; `make test` does the same and runs every test; `make bench` prints the
 # speed figures; `make accuracy` the accuracy table on simulated sequences. `make test-sanitize` runs the
 # suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
-# `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs).
+# `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
+# rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png.
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
 export PATH := /usr/bin:$(PATH)
@@ -17,9 +18,9 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libroscpp-dev libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev \
   libpcl-ros-dev libpcl-conversions-dev librostest-dev python3-rostest libsensor-msgs-dev \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
-  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools
+  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz
 
-.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak clean
+.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -98,6 +99,11 @@ SOAK_SCANS ?= 20000
 SOAK_RATE ?= 1
 soak: build
 	tools/soak.sh $(BUILD) $(SOAK_SCANS) $(SOAK_RATE)
+
+# docs/rviz.png: a simulated drive replayed into rviz on a virtual screen (docs/rviz.md).
+rviz-screenshot: DEB_PACKAGES += xvfb netpbm
+rviz-screenshot: build
+	tools/rviz_screenshot.sh $(BUILD) docs/rviz.png
 
 clean:
 	rm -rf $(BUILD)

@@ -53,6 +53,10 @@ struct GroundConfig {
   double band_above = 0.5;      // delta_h1: a ground point lies below -h_g + band_above
   double band_below = 1.0;      // delta_h2: ... and above -h_g - band_below
   double max_slope_deg = 5.0;   // delta_theta: slope to the next valid pixel up and down the column
+  // Rise (m) allowed on top of delta_theta's. Within about 7 m of an HDL-64E, neighbouring rings meet
+  // the road 0.1-0.3 m apart, where 5 degrees allows 1-2 cm: less than the range noise puts between
+  // them, so without it half of the road within 5 m is labelled non-ground (docs/ground_segmentation.md).
+  double rise_tolerance = 0.03;
 };
 
 // Sec. III-B.3-4, Eq. 10-12: normals of the non-ground range image.

@@ -117,6 +117,8 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("ground.band_above", g.band_above, "delta_h1: ground band above the road height, m (Sec. III-C.1)"),
       bindField("ground.band_below", g.band_below, "delta_h2: ground band below the road height, m (Sec. III-C.1)"),
       bindField("ground.max_slope_deg", g.max_slope_deg, "delta_theta: slope limit between column neighbours, deg (Eq. 13)"),
+      bindField("ground.rise_tolerance", g.rise_tolerance,
+                "rise allowed between column neighbours on top of delta_theta's, m (range noise)"),
       bindChoice("normals.method", n.method,
                  {{NormalMethod::range_adaptive, "range_adaptive"},
                   {NormalMethod::eigen, "eigen"},
@@ -198,6 +200,7 @@ void validate(const Config& c) {
   require(g.band_above > 0.0, "ground.band_above", "must be positive");
   require(g.band_below > 0.0, "ground.band_below", "must be positive");
   require(g.max_slope_deg > 0.0 && g.max_slope_deg < 90.0, "ground.max_slope_deg", "must lie in (0, 90)");
+  require(g.rise_tolerance >= 0.0, "ground.rise_tolerance", "must not be negative");
 
   const NormalConfig& n = c.normals;
   require(n.search_size > 0.0, "normals.search_size", "must be positive");

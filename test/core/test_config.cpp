@@ -98,6 +98,9 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   config = Config();
   config.bev.cell_size = 0.001;
   EXPECT_NE(message_of(config).find("bev.cell_size"), std::string::npos);
+  config = Config();
+  config.ground.rise_tolerance = -0.01;
+  EXPECT_NE(message_of(config).find("ground.rise_tolerance"), std::string::npos);
 }
 
 // The README keeps the few parameters a user is likely to set and links docs/parameters.md for all.
