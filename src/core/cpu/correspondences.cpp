@@ -24,11 +24,9 @@ void accumulate(const PointToPlane& term, TermSums& sums) {
 
 std::vector<int32_t> registrationPixels(const ScanImage& scan) {
   std::vector<int32_t> pixels;
-  for (size_t pixel = 0; pixel < scan.label.size(); ++pixel) {
-    if (scan.label[pixel] == PixelLabel::nonground && scan.image.hasNormal(pixel)) {
-      pixels.push_back(static_cast<int32_t>(pixel));
-    }
-  }
+  parallelSelect(
+      scan.label.size(),
+      [&](size_t pixel) { return scan.label[pixel] == PixelLabel::nonground && scan.image.hasNormal(pixel); }, pixels);
   return pixels;
 }
 
