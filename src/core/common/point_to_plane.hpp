@@ -28,4 +28,22 @@ ELO_HOST_DEVICE inline PointToPlane pointToPlane(const Float3& moved, const Floa
   return {residual, gemanMcClureWeight(residual, kernel_scale), {normal.x, normal.y, normal.z, moment.x, moment.y, moment.z}};
 }
 
+// The Gauss-Newton sums of a set of correspondences in the packed form both backends accumulate: the
+// upper triangle of J^T W J row by row (J^T W J is symmetric, so the lower one is its mirror and costs
+// no products), then J^T W e, then the squared error. The loops have fixed bounds: both compilers unroll
+// them, so the sums stay in registers.
+constexpr int kJtJValues = 21;
+constexpr int kTermValues = kJtJValues + 6 + 1;
+
+ELO_HOST_DEVICE inline void addToPackedSums(const PointToPlane& term, double* values) {
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    const double weighted = term.weight * term.jacobian[i];
+    for (int j = i; j < 6; ++j) values[k++] += weighted * term.jacobian[j];
+  }
+  const double weighted_residual = term.weight * term.residual;
+  for (int i = 0; i < 6; ++i) values[kJtJValues + i] += weighted_residual * term.jacobian[i];
+  values[kTermValues - 1] += term.residual * term.residual;
+}
+
 }  // namespace elo
