@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Speed figures of the offline runner: per-stage ms as the paper's Table V, FPS, peak memory.
-#  1. The CPU backend, frame-to-model and frame-to-frame, with 1 and 2 threads, on the 60 real HDL-64E
-#     scans.
-#  2. Both backends on the same scans, the real ones and a simulated urban drive, frame-to-model, the CPU
+#  1. The CPU backend's scaling on the 60 real HDL-64E scans, frame-to-model: FPS and each stage's
+#     median at 1, 2 and all threads, and each stage's parallel speed-up over 1 thread. Each setting runs
+#     BENCH_REPEAT times (default 3) and keeps each stage's fastest median, so that other load on the
+#     machine shows less.
+#  2. The CPU backend, frame-to-frame, with 1 and 2 threads, on the same scans.
+#  3. Both backends on the same scans, the real ones and a simulated urban drive, frame-to-model, the CPU
 #     with all its threads. The CUDA runs also print the scan's upload to the GPU (part of the projection)
 #     and the FPS without it. Where the CUDA backend cannot run, they are left out, saying why.
 # Usage:
@@ -21,12 +24,54 @@ run() {  # elo_run over $1 with the other arguments, printing its summary
   "$bin/elo_run" --input "$input" --output "$out/poses.txt" --quiet "$@" | sed -n '/^stage/,$p'
 }
 
-if [ -d "$scans" ]; then
-  for mode in f2m f2f; do
-    for threads in 1 2; do
-      echo "=== CPU, $mode, $threads thread(s), $(basename "$scans") ($(ls "$scans" | wc -l) scans)"
-      run "$scans" --mode "$mode" --threads "$threads"
+# scaling: the frame-to-model scaling table of the CPU backend over $scans (see the top).
+scaling() {
+  local repeat=${BENCH_REPEAT:-3} threads run_index
+  echo "=== CPU, f2m, scaling over threads, $(basename "$scans") ($(ls "$scans" | wc -l) scans), fastest of $repeat runs"
+  for threads in 1 2 all; do
+    for run_index in $(seq "$repeat"); do
+      local option=()
+      [ "$threads" != all ] && option=(--threads "$threads")
+      "$bin/elo_run" --input "$scans" --output "$out/poses.txt" --quiet --mode f2m "${option[@]}" \
+        --timing "$out/timing_${threads}_${run_index}.csv" >/dev/null
     done
+  done
+  python3 - "$out" "$repeat" "$(nproc)" <<'PYTHON'
+import csv, statistics, sys
+out, repeat, cores = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+stages = [("spherical projection", "projection_ms"), ("feature extraction", "features_ms"),
+          ("ICP optimization", "registration_ms"), ("model update", "model_update_ms"), ("total", "total_ms")]
+settings = ["1", "2", "all"]
+def fastest(threads, column):  # each run's median over the processed frames; the fastest run's
+    medians = []
+    for run in range(1, repeat + 1):
+        with open(f"{out}/timing_{threads}_{run}.csv") as f:
+            rows = [r for r in csv.DictReader(f) if r["processed"] == "1"]
+        # The first frame is not registered: the registration median is over the registered frames.
+        values = [float(r[column]) for r in rows if column != "registration_ms" or int(r["iterations"]) > 0]
+        medians.append(statistics.median(values))
+    return min(medians)
+table = {s: {t: fastest(t, c) for t in settings} for s, c in stages}
+print(f"{'median ms':<22} {'1 thread':>9} {'2 threads':>10} {'all (' + cores + ')':>9} {'speed-up 2':>11} {'speed-up all':>13}")
+for name, _ in stages:
+    row = table[name]
+    print(f"{name:<22} {row['1']:9.2f} {row['2']:10.2f} {row['all']:9.2f} {row['1'] / row['2']:10.2f}x {row['1'] / row['all']:12.2f}x")
+def fastest_mean_total(threads):
+    means = []
+    for run in range(1, repeat + 1):
+        with open(f"{out}/timing_{threads}_{run}.csv") as f:
+            means.append(statistics.mean(float(r["total_ms"]) for r in csv.DictReader(f) if r["processed"] == "1"))
+    return min(means)
+fps = {t: 1000.0 / fastest_mean_total(t) for t in settings}  # as elo_run's pipeline FPS: 1000 / mean total
+print(f"{'FPS':<22} {fps['1']:9.1f} {fps['2']:10.1f} {fps['all']:9.1f}")
+PYTHON
+}
+
+if [ -d "$scans" ]; then
+  scaling
+  for threads in 1 2; do
+    echo "=== CPU, f2f, $threads thread(s), $(basename "$scans") ($(ls "$scans" | wc -l) scans)"
+    run "$scans" --mode f2f --threads "$threads"
   done
 else
   echo "bench: no real scans at $scans (shared data absent); only the simulated drive is measured" >&2

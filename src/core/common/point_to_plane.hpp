@@ -28,4 +28,34 @@ ELO_HOST_DEVICE inline PointToPlane pointToPlane(const Float3& moved, const Floa
   return {residual, gemanMcClureWeight(residual, kernel_scale), {normal.x, normal.y, normal.z, moment.x, moment.y, moment.z}};
 }
 
+// The Gauss-Newton sums of a set of correspondences in the packed form both backends accumulate: the
+// upper triangle of J^T W J row by row (J^T W J is symmetric, so the lower one is its mirror and costs
+// no products), then J^T W e, then the squared error.
+constexpr int kJtJValues = 21;
+constexpr int kTermValues = kJtJValues + 6 + 1;
+
+namespace detail {
+
+// values[K] += (weight J_I) J_C for every entry (I, C) of the upper triangle from (I, C) on, K counting
+// the entries. A recursion over template arguments rather than a loop, so that every compiler unrolls
+// it and the sums stay in registers (GCC does not unroll the triangular loop on its own).
+template <int I, int C, int K>
+ELO_HOST_DEVICE inline void addUpperTriangle(const PointToPlane& term, double* values) {
+  if constexpr (C < 6) {
+    values[K] += (term.weight * term.jacobian[I]) * term.jacobian[C];
+    addUpperTriangle<I, C + 1, K + 1>(term, values);
+  } else if constexpr (I + 1 < 6) {
+    addUpperTriangle<I + 1, I + 1, K>(term, values);
+  }
+}
+
+}  // namespace detail
+
+ELO_HOST_DEVICE inline void addToPackedSums(const PointToPlane& term, double* values) {
+  detail::addUpperTriangle<0, 0, 0>(term, values);
+  const double weighted_residual = term.weight * term.residual;
+  for (int i = 0; i < 6; ++i) values[kJtJValues + i] += weighted_residual * term.jacobian[i];
+  values[kTermValues - 1] += term.residual * term.residual;
+}
+
 }  // namespace elo

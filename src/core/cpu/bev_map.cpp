@@ -4,6 +4,7 @@
 #include "core/common/association.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/cpu/image_views.hpp"
+#include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
@@ -11,15 +12,20 @@ namespace elo::cpu {
 void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
                     BevImage& ground) {
   const SphericalImage& image = scan.image;
-  std::vector<GroundOffer> offers;
-  for (size_t pixel = 0; pixel < image.pixelCount(); ++pixel) {
-    if (scan.label[pixel] != PixelLabel::ground) continue;
+  const auto cellOfPixel = [&](size_t pixel) {
     int row = 0;
     int col = 0;
-    if (!projection.cellOf(image.vertex[pixel], row, col)) continue;
-    offers.emplace_back(row * projection.cols + col, image.vertex[pixel], image.stamp[pixel],
-                        static_cast<uint32_t>(pixel));
-  }
+    return projection.cellOf(image.vertex[pixel], row, col) ? row * projection.cols + col : -1;
+  };
+  std::vector<int32_t> pixels;
+  parallelSelect(
+      image.pixelCount(),
+      [&](size_t pixel) { return scan.label[pixel] == PixelLabel::ground && cellOfPixel(pixel) >= 0; }, pixels);
+  std::vector<GroundOffer> offers(pixels.size());
+  parallelFor(pixels.size(), [&](size_t i) {
+    const int32_t pixel = pixels[i];
+    offers[i] = {cellOfPixel(pixel), image.vertex[pixel], image.stamp[pixel], static_cast<uint32_t>(pixel)};
+  });
   fillGroundMap(offers, same_surface_distance, ground);
 }
 

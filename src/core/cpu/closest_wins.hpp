@@ -1,6 +1,8 @@
 // "The point closer to the sensor wins" for many writers at once (projection and model update), with
 // the key of closest_wins_key.hpp that the CUDA backend's atomicMin uses too. The minimum is taken with
-// a compare-and-swap loop, so the result does not depend on thread timing.
+// a compare-and-swap loop, so the result does not depend on thread timing. Every pixel starts empty; the
+// stage that reads the winners takes each pixel's key with take(), which empties it again, so no pass
+// of its own (a serial one, or one more sweep over the array) clears it for the next scan.
 #pragma once
 
 #include <atomic>
@@ -15,11 +17,7 @@ class ClosestWins {
  public:
   void resize(size_t pixels) {
     keys_ = std::make_unique<std::atomic<ClosestKey>[]>(pixels);
-    size_ = pixels;
-    reset();
-  }
-  void reset() {
-    for (size_t i = 0; i < size_; ++i) keys_[i].store(kNoClosestKey, std::memory_order_relaxed);
+    for (size_t i = 0; i < pixels; ++i) keys_[i].store(kNoClosestKey, std::memory_order_relaxed);
   }
 
   void offer(size_t pixel, float range, uint32_t source) { offerKey(pixel, closestWinsKey(range, source)); }
@@ -30,13 +28,17 @@ class ClosestWins {
     }
   }
 
-  bool occupied(size_t pixel) const { return keys_[pixel].load(std::memory_order_relaxed) != kNoClosestKey; }
   float range(size_t pixel) const { return closestWinsRange(keys_[pixel].load(std::memory_order_relaxed)); }
-  uint32_t winner(size_t pixel) const { return closestWinsSource(keys_[pixel].load(std::memory_order_relaxed)); }
+  // The pixel's key (kNoClosestKey: no offer), leaving the pixel empty. Only once every offer is in, and
+  // by one thread per pixel.
+  ClosestKey take(size_t pixel) {
+    const ClosestKey key = keys_[pixel].load(std::memory_order_relaxed);
+    if (key != kNoClosestKey) keys_[pixel].store(kNoClosestKey, std::memory_order_relaxed);
+    return key;
+  }
 
  private:
   std::unique_ptr<std::atomic<ClosestKey>[]> keys_;
-  size_t size_ = 0;
 };
 
 }  // namespace elo::cpu

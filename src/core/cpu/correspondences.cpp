@@ -1,9 +1,10 @@
 // Sec. III-B.2 and III-C.2: projective data association of the moved scan with the model, and the
 // point-to-plane sums J^T J, J^T e of each cost term. The association, the gates and the term of each
-// correspondence are shared with the CUDA backend (association.hpp, point_to_plane.hpp); only the sums
-// are the CPU's own (fixed blocks in double, parallel.hpp).
+// correspondence and the packed sums are shared with the CUDA backend (association.hpp,
+// point_to_plane.hpp); only the order of the sums is the CPU's own (fixed blocks in double, parallel.hpp).
 #include "core/common/association.hpp"
 #include "core/common/point_to_plane.hpp"
+#include "core/common/term_sums.hpp"
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
@@ -12,23 +13,32 @@ namespace elo::cpu {
 
 namespace {
 
-void accumulate(const PointToPlane& term, TermSums& sums) {
-  const Eigen::Map<const Vector6d> J(term.jacobian);
-  sums.JtJ.noalias() += term.weight * J * J.transpose();
-  sums.Jte.noalias() += (term.weight * term.residual) * J;
-  sums.squared_error += term.residual * term.residual;
-  ++sums.inliers;
-}
+// The sums of one block of correspondences, packed (point_to_plane.hpp).
+struct PackedSums {
+  double values[kTermValues] = {};
+  int candidates = 0;
+  int inliers = 0;
+
+  void add(const PointToPlane& term) {
+    addToPackedSums(term, values);
+    ++inliers;
+  }
+  PackedSums& operator+=(const PackedSums& other) {
+    for (int v = 0; v < kTermValues; ++v) values[v] += other.values[v];
+    candidates += other.candidates;
+    inliers += other.inliers;
+    return *this;
+  }
+  TermSums unpacked() const { return unpackTermSums(values, candidates, inliers); }
+};
 
 }  // namespace
 
 std::vector<int32_t> registrationPixels(const ScanImage& scan) {
   std::vector<int32_t> pixels;
-  for (size_t pixel = 0; pixel < scan.label.size(); ++pixel) {
-    if (scan.label[pixel] == PixelLabel::nonground && scan.image.hasNormal(pixel)) {
-      pixels.push_back(static_cast<int32_t>(pixel));
-    }
-  }
+  parallelSelect(
+      scan.label.size(),
+      [&](size_t pixel) { return scan.label[pixel] == PixelLabel::nonground && scan.image.hasNormal(pixel); }, pixels);
   return pixels;
 }
 
@@ -39,7 +49,7 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(config);
   const ModelPixels model_pixels(model);
   const SphericalImage& image = scan.image;
-  return deterministicSum<TermSums>(pixels.size(), [&](size_t begin, size_t end, TermSums& sums) {
+  return deterministicSum<PackedSums>(pixels.size(), [&](size_t begin, size_t end, PackedSums& sums) {
     for (size_t i = begin; i < end; ++i) {
       const int32_t pixel = pixels[i];
       ++sums.candidates;
@@ -49,9 +59,9 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
                           toFloat3(image.normal[pixel]), gates, moved, match)) {
         continue;
       }
-      accumulate(pointToPlane(moved, model_pixels.vertex(match), model_pixels.normal(match), kernel_scale), sums);
+      sums.add(pointToPlane(moved, model_pixels.vertex(match), model_pixels.normal(match), kernel_scale));
     }
-  });
+  }).unpacked();
 }
 
 TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const BevProjection& projection,
@@ -60,7 +70,7 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
   const Rigid3f motion = toRigid3f(model_from_scan);
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(registration);
   const GroundPoints model_points(model);
-  return deterministicSum<TermSums>(scan_ground.size(), [&](size_t begin, size_t end, TermSums& sums) {
+  return deterministicSum<PackedSums>(scan_ground.size(), [&](size_t begin, size_t end, PackedSums& sums) {
     for (size_t i = begin; i < end; ++i) {
       ++sums.candidates;
       Float3 moved;
@@ -71,9 +81,9 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
       }
       const Float3 normal = toFloat3(normals.normal(model, projection, bev, match));
       if (isZero(normal)) continue;
-      accumulate(pointToPlane(moved, model_points.vertex(match), normal, kernel_scale), sums);
+      sums.add(pointToPlane(moved, model_points.vertex(match), normal, kernel_scale));
     }
-  });
+  }).unpacked();
 }
 
 }  // namespace elo::cpu

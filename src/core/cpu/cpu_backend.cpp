@@ -47,12 +47,15 @@ void CpuBackend::segmentGround() {
 }
 
 void CpuBackend::estimateNormals() {
-  arena_.execute([&] { cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_); });
-  registration_pixels_ = registrationPixels(scan_);
+  arena_.execute([&] {
+    cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_);
+    registration_pixels_ = registrationPixels(scan_);
+  });
 }
 
 void CpuBackend::buildGroundMap() {
-  cpu::buildGroundMap(scan_, bev_, static_cast<float>(config_.model.same_surface_distance), scan_ground_);
+  arena_.execute(
+      [&] { cpu::buildGroundMap(scan_, bev_, static_cast<float>(config_.model.same_surface_distance), scan_ground_); });
 }
 
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {

@@ -4,7 +4,7 @@
 // stays, and points older than tau_w go. Only three 2D maps are kept (vertex and normal maps of the SRI,
 // vertex map of the BEV), so memory never grows. The per-point rules are shared with the CUDA backend
 // (model_update.hpp).
-#include <algorithm>
+#include <vector>
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
@@ -57,8 +57,6 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 
   ClosestWins& closest = scratch.closest;
   ClosestWins& oldest = scratch.oldest;
-  closest.reset();
-  oldest.reset();
   // Round 1 moves each model point once; round 2 reuses where it landed.
   parallelFor(pixels, [&](size_t pixel) {
     moveModelPoint(model, pixel, scan_from_model, projection, fusion, scratch);
@@ -73,13 +71,16 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
     });
   });
 
+  // Taking each pixel's winners empties both rounds for the next update.
   parallelFor(pixels, [&](size_t pixel) {
-    if (!oldest.occupied(pixel)) {
+    closest.take(pixel);
+    const ClosestKey winner = oldest.take(pixel);
+    if (winner == kNoClosestKey) {
       fused.range[pixel] = 0.0f;
       fused.normal[pixel].setZero();
       return;
     }
-    const uint32_t source = oldest.winner(pixel);
+    const uint32_t source = closestWinsSource(winner);
     if (isScanSource(source, pixels)) {
       const size_t from = source - pixels;
       fused.vertex[pixel] = observed.vertex[from];
@@ -98,26 +99,31 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
                      const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
-  // Model points move in parallel, each into its own entry; the ones not offered are then removed in
-  // order, so the offers keep the order of their sources, which gives the map's slots.
-  std::vector<GroundOffer> offers;
-  offers.reserve(model.size() + scan_ground.size());
-  offers.resize(model.size());
+  // Model points move in parallel, each into its own entry (cell -1: not offered); the offered ones are
+  // then gathered in order and the scan's points follow, so the offers keep the order of their sources,
+  // which gives the map's slots.
+  std::vector<GroundOffer> moved(model.size());
   parallelFor(model.size(), [&](size_t point) {
     if (!isCurrent(fusion.now, model.stamp[point], fusion.time_window)) return;
-    const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[point]));
+    const Float3 position = scan_from_model.apply(toFloat3(model.vertex[point]));
     int row = 0;
     int col = 0;
-    if (!projection.cellOf(moved, row, col)) return;
-    offers[point] = {row * projection.cols + col, toVec3f(moved), model.stamp[point], static_cast<uint32_t>(point)};
+    if (!projection.cellOf(position, row, col)) return;
+    moved[point] = {row * projection.cols + col, toVec3f(position), model.stamp[point], static_cast<uint32_t>(point)};
   });
-  offers.erase(std::remove_if(offers.begin(), offers.end(), [](const GroundOffer& offer) { return offer.cell < 0; }),
-               offers.end());
+  std::vector<int32_t> offered;
+  parallelSelect(model.size(), [&](size_t point) { return moved[point].cell >= 0; }, offered);
   const uint32_t model_points = static_cast<uint32_t>(model.size());
-  for (size_t point = 0; point < scan_ground.size(); ++point) {
-    offers.emplace_back(scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
-                        model_points + static_cast<uint32_t>(point));
-  }
+  std::vector<GroundOffer> offers(offered.size() + scan_ground.size());
+  parallelFor(offers.size(), [&](size_t i) {
+    if (i < offered.size()) {
+      offers[i] = moved[offered[i]];
+      return;
+    }
+    const size_t point = i - offered.size();
+    offers[i] = {scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
+                 model_points + static_cast<uint32_t>(point)};
+  });
   fillGroundMap(offers, fusion.same_surface_distance, fused);
 }
 

@@ -23,9 +23,11 @@ struct Window {
 
 // Sums over the segments of a window, written as masked arithmetic over plain arrays so that the
 // compiler turns each segment into a few vector instructions: a neighbour is usable (non-ground) and
-// inside the window, then near (test 1) and on the plane (test 2). Each quantity is summed per lane and
-// the lanes are added only once, in a fixed order: a float sum across lanes per segment would have to
-// be done one lane at a time (float addition is not associative), which cost more than the arithmetic.
+// inside the window, then near (test 1) and, with kPlaneTest, on the plane (test 2). Each quantity is
+// summed per lane, over the rows from the top, and the lanes are added only once, in a fixed order: a
+// float sum across lanes per segment would have to be done one lane at a time (float addition is not
+// associative), which cost more than the arithmetic.
+template <bool kPlaneTest>
 class WindowSums {
  public:
   static constexpr int kLanes = kWindowLanes;
@@ -36,71 +38,95 @@ class WindowSums {
         plane_(plane),
         plane_distance_squared_(plane_distance * plane_distance) {}
 
-  void addSegment(const NormalScratch& planes, size_t start, const float* __restrict window) {
-    for (int base = 0; base < planes.span; base += kLanes) addLanes(planes, start + base, window + base);
+  // Adds the window rows first_row to last_row around column `col`; `window` is the mask of the window's
+  // half-width `half_width`. The lanes outside the window add only exact zeros (the mask zeroes them,
+  // and the scratch holds no NaN), so where the window lies within the middle half of a one-block
+  // segment (lanes 4 to 11) the other half is left out: the sums are the same bit for bit, at half the
+  // work for the narrow windows of distant points.
+  void addRows(const NormalScratch& planes, int first_row, int last_row, int col, const float* window, int half_width) {
+    if (planes.span == kLanes && half_width < kLanes / 4) {
+      addLanes<kLanes / 4, kLanes / 2>(planes, first_row, last_row, col, window);
+    } else {
+      addLanes<0, kLanes>(planes, first_row, last_row, col, window);
+    }
   }
 
-  int neighbours() const { return static_cast<int>(total(kNeighbours)); }
-  int distant() const { return static_cast<int>(total(kDistant)); }
+  int neighbours() const { return static_cast<int>(totals_[kNeighbours]); }
+  int distant() const { return static_cast<int>(totals_[kDistant]); }
 
   PointMoments moments() const {
     PointMoments m;
-    m.sum = {total(kSx), total(kSy), total(kSz)};
-    m.outer = {total(kSxx), total(kSxy), total(kSxz), total(kSyy), total(kSyz), total(kSzz)};
-    m.count = static_cast<int>(total(kCount));
+    m.sum = {totals_[kSx], totals_[kSy], totals_[kSz]};
+    m.outer = {totals_[kSxx], totals_[kSxy], totals_[kSxz], totals_[kSyy], totals_[kSyz], totals_[kSzz]};
+    m.count = static_cast<int>(totals_[kCount]);
     return m;
   }
 
  private:
   enum Quantity { kNeighbours, kDistant, kCount, kSx, kSy, kSz, kSxx, kSxy, kSxz, kSyy, kSyz, kSzz, kQuantities };
 
-  void addLanes(const NormalScratch& planes, size_t start, const float* __restrict window) {
-    const float* __restrict x = planes.x.data() + start;
-    const float* __restrict y = planes.y.data() + start;
-    const float* __restrict z = planes.z.data() + start;
-    const float* __restrict usable = planes.usable.data() + start;
-    for (int i = 0; i < kLanes; ++i) {
-      const float dx = x[i] - centre_.x();
-      const float dy = y[i] - centre_.y();
-      const float dz = z[i] - centre_.z();
-      const float present = usable[i] * window[i];
-      // Selects, not branches or bool-to-float casts: both become vector blends.
-      const float far = windowSquaredDistance(dx, dy, dz) > distant_squared_ ? present : 0.0f;
-      const float plane_offset = windowPlaneOffset(dx, dy, dz, plane_.x(), plane_.y(), plane_.z());
-      const float on_plane = plane_offset * plane_offset > plane_distance_squared_ ? 0.0f : 1.0f;
-      const float kept = (present - far) * on_plane;  // 0 or 1: the products with it below are exact
-      lanes_[kNeighbours][i] += present;
-      lanes_[kDistant][i] += far;
-      lanes_[kCount][i] += kept;
-      lanes_[kSx][i] += kept * dx;
-      lanes_[kSy][i] += kept * dy;
-      lanes_[kSz][i] += kept * dz;
-      // The fused multiply-adds GCC would contract these into, written out, so that gatherWindow() of
-      // normals.hpp (the GPU's loop) rounds the same.
-      lanes_[kSxx][i] = fusedMultiplyAdd(kept * dx, dx, lanes_[kSxx][i]);
-      lanes_[kSxy][i] = fusedMultiplyAdd(kept * dx, dy, lanes_[kSxy][i]);
-      lanes_[kSxz][i] = fusedMultiplyAdd(kept * dx, dz, lanes_[kSxz][i]);
-      lanes_[kSyy][i] = fusedMultiplyAdd(kept * dy, dy, lanes_[kSyy][i]);
-      lanes_[kSyz][i] = fusedMultiplyAdd(kept * dy, dz, lanes_[kSyz][i]);
-      lanes_[kSzz][i] = fusedMultiplyAdd(kept * dz, dz, lanes_[kSzz][i]);
+  // Lanes kFirst to kFirst + kWidth - 1 of every segment; the others stay zero. The sums are local, so
+  // the compiler knows the scratch cannot alias them and keeps them in registers across the rows.
+  template <int kFirst, int kWidth>
+  void addLanes(const NormalScratch& planes, int first_row, int last_row, int col, const float* __restrict window) {
+    float sums[kQuantities][kWidth] = {};
+    for (int r = first_row; r <= last_row; ++r) {
+      // One block of lanes for the usual spans; wider ones add their blocks row by row, in order.
+      for (int base = 0; base < planes.span; base += kLanes) {
+        const size_t start = planes.segmentStart(r, col) + base + kFirst;
+        const float* __restrict x = planes.x.data() + start;
+        const float* __restrict y = planes.y.data() + start;
+        const float* __restrict z = planes.z.data() + start;
+        const float* __restrict usable = planes.usable.data() + start;
+        const float* __restrict mask = window + base + kFirst;
+        for (int i = 0; i < kWidth; ++i) {
+          const float dx = x[i] - centre_.x();
+          const float dy = y[i] - centre_.y();
+          const float dz = z[i] - centre_.z();
+          const float present = usable[i] * mask[i];
+          // Selects, not branches or bool-to-float casts: both become vector blends.
+          const float far = windowSquaredDistance(dx, dy, dz) > distant_squared_ ? present : 0.0f;
+          float kept = present - far;  // 0 or 1: the products with it below are exact
+          if constexpr (kPlaneTest) {
+            const float plane_offset = windowPlaneOffset(dx, dy, dz, plane_.x(), plane_.y(), plane_.z());
+            kept *= plane_offset * plane_offset > plane_distance_squared_ ? 0.0f : 1.0f;
+          }
+          sums[kNeighbours][i] += present;
+          sums[kDistant][i] += far;
+          sums[kCount][i] += kept;
+          sums[kSx][i] += kept * dx;
+          sums[kSy][i] += kept * dy;
+          sums[kSz][i] += kept * dz;
+          // The fused multiply-adds GCC would contract these into, written out, so that gatherWindow()
+          // of normals.hpp (the GPU's loop) rounds the same.
+          sums[kSxx][i] = fusedMultiplyAdd(kept * dx, dx, sums[kSxx][i]);
+          sums[kSxy][i] = fusedMultiplyAdd(kept * dx, dy, sums[kSxy][i]);
+          sums[kSxz][i] = fusedMultiplyAdd(kept * dx, dz, sums[kSxz][i]);
+          sums[kSyy][i] = fusedMultiplyAdd(kept * dy, dy, sums[kSyy][i]);
+          sums[kSyz][i] = fusedMultiplyAdd(kept * dy, dz, sums[kSyz][i]);
+          sums[kSzz][i] = fusedMultiplyAdd(kept * dz, dz, sums[kSzz][i]);
+        }
+      }
     }
-  }
-
-  // Pairwise over the lanes, always in the same order.
-  float total(Quantity quantity) const {
-    float lanes[kLanes];
-    for (int i = 0; i < kLanes; ++i) lanes[i] = lanes_[quantity][i];
-    for (int width = kLanes / 2; width > 0; width /= 2) {
-      for (int i = 0; i < width; ++i) lanes[i] += lanes[i + width];
+    // Pairwise over the lanes, always in the same order: lane i += lane i + 8, + 4, + 2, + 1.
+    float lanes[kQuantities][kLanes] = {};
+    for (int q = 0; q < kQuantities; ++q) {
+      for (int i = 0; i < kWidth; ++i) lanes[q][kFirst + i] = sums[q][i];
     }
-    return lanes[0];
+    static_assert(kLanes == 16, "the pairwise sum below is written out for 16 lanes");
+    for (int q = 0; q < kQuantities; ++q) {
+      for (int i = 0; i < 8; ++i) lanes[q][i] += lanes[q][i + 8];
+      for (int i = 0; i < 4; ++i) lanes[q][i] += lanes[q][i + 4];
+      for (int i = 0; i < 2; ++i) lanes[q][i] += lanes[q][i + 2];
+      totals_[q] = lanes[q][0] + lanes[q][1];
+    }
   }
 
   Vec3f centre_;
   float distant_squared_;
   Vec3f plane_;
   float plane_distance_squared_;
-  alignas(64) float lanes_[kQuantities][kLanes] = {};
+  float totals_[kQuantities] = {};
 };
 
 }  // namespace
@@ -194,18 +220,25 @@ class NormalEstimator {
   // `plane` normal, test 2: neighbours farther than sigma_z from the plane through the centre are left out.
   bool gatherNeighbours(size_t pixel, const Window& window, bool reject_distant, const Float3* plane,
                         PointMoments& moments) const {
+    const Vec3f centre = image_.vertex[pixel];
+    const float distant_squared =
+        reject_distant ? static_cast<float>(config_.outlier_distance * config_.outlier_distance) : INFINITY;
+    if (plane == nullptr) {
+      WindowSums<false> sums(centre, distant_squared, Vec3f::Zero(), INFINITY);
+      return sumWindow(pixel, window, sums, moments);
+    }
+    WindowSums<true> sums(centre, distant_squared, toVec3f(*plane), static_cast<float>(config_.plane_distance));
+    return sumWindow(pixel, window, sums, moments);
+  }
+
+  template <typename Sums>
+  bool sumWindow(size_t pixel, const Window& window, Sums& sums, PointMoments& moments) const {
     const int cols = projection_.cols;
     const int row = static_cast<int>(pixel) / cols;
     const int col = static_cast<int>(pixel) % cols;
-    WindowSums sums(image_.vertex[pixel],
-                    reject_distant ? static_cast<float>(config_.outlier_distance * config_.outlier_distance) : INFINITY,
-                    plane ? toVec3f(*plane) : Vec3f::Zero(),
-                    plane ? static_cast<float>(config_.plane_distance) : INFINITY);
     const float* mask = planes_.window_mask.data() + static_cast<size_t>(window.half_width) * planes_.span;
-    for (int r = std::max(0, row - window.half_height); r <= std::min(projection_.rows - 1, row + window.half_height);
-         ++r) {
-      sums.addSegment(planes_, planes_.segmentStart(r, col), mask);
-    }
+    sums.addRows(planes_, std::max(0, row - window.half_height), std::min(projection_.rows - 1, row + window.half_height),
+                 col, mask, window.half_width);
     moments = sums.moments();
     return 2 * sums.distant() <= sums.neighbours() - 1;  // the centre is not its own neighbour
   }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #if defined(__SANITIZE_THREAD__)
@@ -71,9 +72,44 @@ Sum deterministicSum(size_t count, const Body& body) {
   order.beforeLoop(sum_block);
   tbb::parallel_for(size_t{0}, blocks, sum_block);
   order.afterLoop();
-  Sum total;
+  Sum total{};
   for (const Sum& partial : partials) total += partial;
   return total;
+}
+
+// The indices i in [0, count) for which `keep(i)` holds, in increasing order, into `selected`: each
+// fixed block counts its kept indices, the counts place the blocks one after another, and each block
+// writes its own, so the list is found in parallel and comes out the same whatever the thread count.
+template <typename Keep>
+void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& selected) {
+  constexpr size_t kBlock = 4096;
+  const size_t blocks = (count + kBlock - 1) / kBlock;
+  std::vector<size_t> first(blocks + 1, 0);  // first[b + 1]: block b's count, then where it starts
+  ForkJoinOrder counting;
+  const auto count_block = [&](size_t block) {
+    ForkJoinOrder::taskStarts();
+    size_t kept = 0;
+    for (size_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) kept += keep(i) ? 1 : 0;
+    first[block + 1] = kept;
+    counting.taskEnds();
+  };
+  counting.beforeLoop(count_block);
+  tbb::parallel_for(size_t{0}, blocks, count_block);
+  counting.afterLoop();
+  for (size_t block = 0; block < blocks; ++block) first[block + 1] += first[block];
+  selected.resize(first[blocks]);
+  ForkJoinOrder writing;
+  const auto write_block = [&](size_t block) {
+    ForkJoinOrder::taskStarts();
+    size_t at = first[block];
+    for (size_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
+      if (keep(i)) selected[at++] = static_cast<int32_t>(i);
+    }
+    writing.taskEnds();
+  };
+  writing.beforeLoop(write_block);
+  tbb::parallel_for(size_t{0}, blocks, write_block);
+  writing.afterLoop();
 }
 
 // Runs `body(i)` for every i in [0, count) across the threads of the current arena.

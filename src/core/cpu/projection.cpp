@@ -11,7 +11,6 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
                     const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan) {
   const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
   const bool use_ring = !ring_rows.empty() && cloud.ring.size() == cloud.points.size();
-  winners.reset();
   parallelFor(cloud.points.size(), [&](size_t i) {
     Float3 corrected;
     int pixel = 0;
@@ -23,26 +22,28 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
     winners.offer(pixel, norm(corrected), static_cast<uint32_t>(i));
   });
 
+  // Each pixel takes its winner (which empties the pixel for the next scan). The winner's range is the
+  // one its key holds: the same norm of the same corrected point.
   SphericalImage& image = scan.image;
-  std::atomic<size_t> occupied{0};
-  parallelFor(image.pixelCount(), [&](size_t pixel) {
-    image.normal[pixel].setZero();
-    if (!winners.occupied(pixel)) {
-      image.range[pixel] = 0.0f;
-      scan.point_index[pixel] = -1;
-      scan.label[pixel] = PixelLabel::empty;
-      return;
+  return deterministicSum<size_t>(image.pixelCount(), [&](size_t begin, size_t end, size_t& occupied) {
+    for (size_t pixel = begin; pixel < end; ++pixel) {
+      const ClosestKey key = winners.take(pixel);
+      image.normal[pixel].setZero();
+      if (key == kNoClosestKey) {
+        image.range[pixel] = 0.0f;
+        scan.point_index[pixel] = -1;
+        scan.label[pixel] = PixelLabel::empty;
+        continue;
+      }
+      const uint32_t index = closestWinsSource(key);
+      image.vertex[pixel] = toVec3f(correction.apply(toFloat3(cloud.points[index])));
+      image.range[pixel] = closestWinsRange(key);
+      image.stamp[pixel] = stamp;
+      scan.point_index[pixel] = static_cast<int32_t>(index);
+      scan.label[pixel] = PixelLabel::nonground;
+      ++occupied;
     }
-    const uint32_t index = winners.winner(pixel);
-    const Float3 p = correction.apply(toFloat3(cloud.points[index]));
-    image.vertex[pixel] = toVec3f(p);
-    image.range[pixel] = norm(p);
-    image.stamp[pixel] = stamp;
-    scan.point_index[pixel] = static_cast<int32_t>(index);
-    scan.label[pixel] = PixelLabel::nonground;
-    occupied.fetch_add(1, std::memory_order_relaxed);
   });
-  return occupied.load();
 }
 
 }  // namespace elo::cpu

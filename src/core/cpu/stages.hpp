@@ -16,7 +16,8 @@
 namespace elo::cpu {
 
 // projection.cpp: the closest point of the cloud per pixel; `ring_rows` maps a driver's ring index to
-// its row (empty: rows from the elevation). Returns the number of occupied pixels.
+// its row (empty: rows from the elevation). `winners` must be empty, as resize() leaves it, and is left
+// empty. Returns the number of occupied pixels.
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan);
 
@@ -102,7 +103,8 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
 // Results go to `fused`.
 //
 // The spherical update's scratch, kept by the backend to reuse its memory: each pixel's winner of each
-// round, and where each model pixel lands once moved into the scan's frame.
+// round (empty between updates, as resize() leaves them), and where each model pixel lands once moved
+// into the scan's frame.
 struct SphericalFusionScratch {
   ClosestWins closest;               // round 1: the closest offer
   ClosestWins oldest;                // round 2: the oldest offer on the closest surface

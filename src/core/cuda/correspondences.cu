@@ -23,19 +23,8 @@ struct ThreadSums {
     for (double& value : values) value = 0.0;
   }
 
-  // JtJ += w J J^T (upper triangle), Jte += (w e) J, as the CPU backend's accumulate().
   __device__ void add(const PointToPlane& term) {
-    int k = 0;
-#pragma unroll
-    for (int i = 0; i < 6; ++i) {
-      const double weighted = term.weight * term.jacobian[i];
-#pragma unroll
-      for (int j = i; j < 6; ++j) values[k++] += weighted * term.jacobian[j];
-    }
-    const double weighted_residual = term.weight * term.residual;
-#pragma unroll
-    for (int i = 0; i < 6; ++i) values[kJtJValues + i] += weighted_residual * term.jacobian[i];
-    values[kTermValues - 1] += term.residual * term.residual;
+    addToPackedSums(term, values);
     ++inliers;
   }
 };

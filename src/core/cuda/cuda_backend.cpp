@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "core/common/eigen_interop.hpp"
+#include "core/common/term_sums.hpp"
 #include "elo/sensor_model.hpp"
 
 namespace elo::cuda {
@@ -29,18 +30,8 @@ void copyToHost(std::vector<Host>& host, const Device* device, size_t count, cud
         "copying a buffer to the host");
 }
 
-// JtJ comes as its upper triangle, row by row.
 TermSums toTermSums(const DeviceTermSums& device) {
-  TermSums sums;
-  int k = 0;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = i; j < 6; ++j) sums.JtJ(i, j) = sums.JtJ(j, i) = device.values[k++];
-  }
-  for (int i = 0; i < 6; ++i) sums.Jte(i) = device.values[kJtJValues + i];
-  sums.squared_error = device.values[kTermValues - 1];
-  sums.candidates = device.candidates;
-  sums.inliers = device.inliers;
-  return sums;
+  return unpackTermSums(device.values, device.candidates, device.inliers);
 }
 
 }  // namespace

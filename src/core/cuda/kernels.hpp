@@ -13,6 +13,7 @@
 #include "core/common/ground.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
+#include "core/common/point_to_plane.hpp"
 #include "core/cuda/device_views.hpp"
 
 namespace elo::cuda {
@@ -88,10 +89,8 @@ void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, c
                         ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
-// correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A). JtJ is summed as its upper
-// triangle, row by row.
-constexpr int kJtJValues = 21;
-constexpr int kTermValues = kJtJValues + 6 + 1;  // JtJ, Jte, squared error
+// correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A), packed as
+// point_to_plane.hpp lays them out.
 struct DeviceTermSums {
   double values[kTermValues];
   int candidates;
