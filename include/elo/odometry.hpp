@@ -90,7 +90,9 @@ class Odometry {
   // while that changes the deskew by more than a converged step over the sweep (`farthest` seconds
   // either side of the reference; changesRegistration()). Against a provisional model the scan is
   // deskewed once, for the model, and the registration ends (docs/deskew.md).
-  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, double farthest, FrameResult& result);
+  // `deskewed`: the velocity the projection deskewed the scan under.
+  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                         FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;

@@ -60,8 +60,9 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
-void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, double farthest, FrameResult& result) {
-  Vector6d deskewed_under = sweepVelocity(guess, dt);
+void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                                 FrameResult& result) {
+  Vector6d deskewed_under = deskewed;
   const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& registered) {
     if (result.time_source == TimeSource::none) return false;
     // The scan that replaces a provisional model is deskewed for it whatever deskew.rounds says.
@@ -106,8 +107,9 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
-  // Deskewed under the prior's velocity: the first scans (no prior yet) as they were measured.
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweepVelocity(guess, dt)});
+  // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
+  const Vector6d sweep_velocity = started_ ? motion_.velocity() : Vector6d::Zero();
+  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity});
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
@@ -125,7 +127,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
-    registerAndDeskew(guess, dt, times.farthest, result);
+    registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;
     motion_.record(result.delta, dt);
