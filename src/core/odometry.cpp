@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "elo/deskew.hpp"
+
 namespace elo {
 
 namespace {
@@ -60,6 +62,33 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
+void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                                 FrameResult& result) {
+  Vector6d deskewed_under = deskewed;
+  const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& registered) {
+    if (result.time_source == TimeSource::none) return false;
+    // The scan that replaces a provisional model is deskewed for it whatever deskew.rounds says.
+    const int rounds = model_provisional_ ? 1 : config_.deskew.rounds;
+    const Vector6d velocity = sweepVelocity(registered, dt);
+    if (result.deskew_rounds >= rounds || !changesRegistration(deskewed_under, velocity, farthest, config_.registration)) {
+      return false;
+    }
+    const auto deskew_start = Clock::now();
+    backend_->deskewScan(velocity);
+    backend_->buildGroundMap();
+    backend_->synchronize();
+    result.times.deskew += millisecondsSince(deskew_start);
+    deskewed_under = velocity;
+    ++result.deskew_rounds;
+    // Against a model of the first scan as measured, the scan as measured registers best (the two are
+    // bent alike): deskewed, it only replaces that model.
+    return !model_provisional_;
+  };
+  const auto stage_start = Clock::now();
+  result.registration = registerScan(*backend_, guess, motion_.informed(), config_.registration, deskew_again);
+  result.times.registration = millisecondsSince(stage_start) - result.times.deskew;
+}
+
 FrameResult Odometry::process(const PointCloud& cloud) {
   if (cloud.points.empty()) return skip("empty cloud");
   if (!std::isfinite(cloud.stamp)) return skip("stamp not finite");
@@ -72,14 +101,24 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   const auto frame_start = Clock::now();
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
   const float relative_stamp = static_cast<float>(since_first);
+  const CloudTimes times = inspectTimes(cloud, config_);
+  result.time_source = times.source;
+  result.time_warning = times.warning;
+  result.points_without_time = times.outside_sweep;
+  if (!times.warning.empty()) ++time_warnings_[times.warning];
+  const double dt = started_ ? since_first - last_since_first_ : 0.0;
+  const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp);
+  // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
+  const Vector6d sweep_velocity = started_ ? motion_.velocity() : Vector6d::Zero();
+  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity});
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
     skipped.reset = result.reset;
     skipped.gap_restart = result.gap_restart;
+    skipped.time_warning = result.time_warning;
     return skipped;
   }
 
@@ -91,10 +130,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
-    const double dt = since_first - last_since_first_;
-    stage_start = Clock::now();
-    result.registration = registerScan(*backend_, motion_.predict(dt), motion_.informed(), config_.registration);
-    result.times.registration = millisecondsSince(stage_start);
+    registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;
     motion_.record(result.delta, dt);
@@ -106,6 +142,8 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   }
 
   stage_start = Clock::now();
+  if (model_provisional_) backend_->resetModel();
+  model_provisional_ = !started_ && times.source != TimeSource::none;
   backend_->updateModel(result.delta, relative_stamp);
   backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);

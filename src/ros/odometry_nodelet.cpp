@@ -163,6 +163,10 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
     return;
   }
   if (!bindFrames(message.header.frame_id)) return;
+  if (!converted.time_problem.empty() && odometry_->config().deskew.time_source == elo::TimeSource::field) {
+    // The core counts the scan as one without usable times (elo::FrameResult::time_warning).
+    NODELET_WARN_THROTTLE(kWarningPeriod, "%s", converted.time_problem.c_str());
+  }
 
   std::unique_lock<std::mutex> lock(odometry_mutex_);
   const elo::FrameResult result = odometry_->process(converted.cloud);
@@ -170,6 +174,9 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   // Every scan the core saw, a skipped one repeating the last pose: the lines match elo_run's.
   trajectory_stamps_.push_back(converted.cloud.stamp);
   trajectory_poses_.push_back(result.pose);
+  if (!result.time_warning.empty()) {
+    NODELET_WARN_THROTTLE(kWarningPeriod, "per-point times: %s (deskew.time_source)", result.time_warning.c_str());
+  }
   if (!result.processed) {
     lock.unlock();
     statistics_.scanSkipped(result.skip_reason);
