@@ -90,15 +90,20 @@ Eigen::Vector3d Lidar::actualDirection(int beam, int step) const {
 }
 
 SimulatedScan Lidar::sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
-                           double stamp, uint64_t seed) const {
+                           double start, uint64_t seed) const {
   std::vector<Eigen::Isometry3d> poses;
   if (options_.deskewed) {
-    poses.assign(1, sensor_pose_at(stamp));
+    poses.assign(1, sensor_pose_at(start));
   } else {
     poses.reserve(azimuthSteps());
-    for (int step = 0; step < azimuthSteps(); ++step) poses.push_back(sensor_pose_at(stamp + firingTime(step)));
+    for (int step = 0; step < azimuthSteps(); ++step) poses.push_back(sensor_pose_at(start + firingTime(step)));
   }
-  return addNoise(castAll(scene, poses), stamp, seed);
+  return addNoise(castAll(scene, poses), start, seed);
+}
+
+double Lidar::referenceOffset() const {
+  const bool mid_sweep = !options_.deskewed && options_.time_convention == TimeConvention::azimuth;
+  return mid_sweep ? 0.5 * sweepDuration() : 0.0;
 }
 
 std::vector<Lidar::Return> Lidar::castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const {
@@ -161,12 +166,13 @@ double Lidar::clutteredRange(const Return& previous, const Return& result, const
   return range;
 }
 
-SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const {
+SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double start, uint64_t seed) const {
   // One random stream in firing order: the same seed gives the same sweep whatever the thread count.
   Rng rng(seed);
   const int beams = beamCount();
+  const bool with_times = !options_.deskewed && options_.time_convention == TimeConvention::field;
   SimulatedScan scan;
-  scan.cloud.stamp = stamp;
+  scan.cloud.stamp = start + referenceOffset();
   for (int step = 0; step < azimuthSteps(); ++step) {
     for (int beam = 0; beam < beams; ++beam) {
       const Return& result = returns[static_cast<size_t>(step) * beams + beam];
@@ -182,7 +188,7 @@ SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, 
       scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
       scan.cloud.intensity.push_back(result.intensity);
       scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
-      scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
+      if (with_times) scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
       scan.surface.push_back(result.kind);
     }
   }

@@ -40,12 +40,14 @@ Simulation::Simulation(const SimulationSpec& spec)
   trajectory_ = std::make_unique<SensorTrajectory>(route, world_->ground(), spec.config.ground.sensor_height);
 }
 
-double Simulation::stamp(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }
+double Simulation::sweepStart(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }
+
+double Simulation::stamp(int frame) const { return sweepStart(frame) + lidar_.referenceOffset(); }
 
 Eigen::Isometry3d Simulation::sensorPose(int frame) const { return trajectory_->poseAt(stamp(frame)); }
 
 SimulatedScan Simulation::scan(int frame) const {
-  const double start = stamp(frame);
+  const double start = sweepStart(frame);
   const Eigen::Isometry3d pose = trajectory_->poseAt(start);
   // Moving cars stand where they are at the sweep's start; they move a metre or two during it.
   const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
