@@ -31,6 +31,14 @@ struct NormalEquations {
   TermSums ground;     // E_G: scan BEV against the model BEV
 };
 
+// How the projection deskews a scan (docs/deskew.md): where its points' times come from (deskew.time_source,
+// or `none` for a cloud without usable times: instantaneous) and the sensor's velocity over the sweep, a
+// twist per second (translation, rotation) in the scan's frame at its reference instant.
+struct SweepMotion {
+  TimeSource times = TimeSource::none;
+  Vector6d velocity = Vector6d::Zero();
+};
+
 // A device backend queues the work of a stage call and returns; a call whose result the host needs (the
 // occupied count, the sums, the host views) waits for it. The CPU backend finishes every call at once.
 class Backend {
@@ -38,10 +46,16 @@ class Backend {
   virtual ~Backend() = default;
   virtual const char* name() const = 0;
 
-  // Sec. III-B.1: spherical projection of the cloud (closest point per pixel). `stamp` is the scan's
-  // time in seconds since the first scan; it becomes the observation time of every vertex. Returns the
-  // number of occupied pixels.
-  virtual size_t projectScan(const PointCloud& cloud, float stamp) = 0;
+  // Sec. III-B.1: spherical projection of the cloud (closest point per pixel), every point deskewed by
+  // `motion` first. `stamp` is the scan's time in seconds since the first scan; it becomes the
+  // observation time of every vertex. Returns the number of occupied pixels. A point whose own time
+  // (`field`) lies outside the sweep (SweepTiming::withinSweep()) is dropped. A `field` source with a
+  // cloud whose times are missing or not one per point is taken as `none`.
+  virtual size_t projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion = {}) = 0;
+  // Deskews the projected scan again under `velocity` (as SweepMotion::velocity): every vertex from its
+  // measured point and time, every normal turned with it. Pixels, labels and the registration pixels
+  // stay; the ground map must be built again (buildGroundMap()). Nothing to do for an instantaneous scan.
+  virtual void deskewScan(const Vector6d& velocity) = 0;
   // Sec. III-C.1: labels every occupied pixel ground or non-ground.
   virtual void segmentGround() = 0;
   // Sec. III-B.3-4: normals and curvature gating of the non-ground pixels.

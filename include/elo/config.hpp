@@ -19,6 +19,10 @@ enum class NormalMethod { range_adaptive, eigen, cross_product };
 enum class RegistrationMode { frame_to_model, frame_to_frame };
 enum class MotionPrior { constant_acceleration, constant_velocity, none };
 enum class BackendKind { cpu, cuda };
+// Where each point's firing time comes from, for deskewing (docs/deskew.md): nowhere (every scan is
+// instantaneous), the cloud's own per-point times (PointCloud::time), or the point's azimuth along the
+// sensor's rotation (sensor.rotation_rate_hz, sensor.clockwise, sensor.sweep_start_azimuth_deg).
+enum class TimeSource { none, field, azimuth };
 
 // Sec. III-B.1, Eq. 3-4: the sensor and its spherical range image.
 struct SensorConfig {
@@ -39,7 +43,15 @@ struct SensorConfig {
   std::vector<double> beam_elevations_deg = hdl64BeamElevations();
   int beam_count = 64;
   int azimuth_steps = 2083;        // firings per revolution (simulator)
-  double rotation_rate_hz = 10.0;  // revolutions per second (simulator, per-point time)
+  // Revolutions per second: the simulator's sweep, the times deskew.time_source azimuth gives, and the
+  // window per-point times must lie in (one sweep either side of the stamp, with a margin).
+  double rotation_rate_hz = 10.0;
+  // The sweep of deskew.time_source azimuth (and of the simulator): the direction of rotation seen from
+  // above (x forward, y left, z up) and the azimuth (deg, counter-clockwise from x) where each sweep
+  // starts and ends. KITTI's HDL-64E: clockwise, starting straight behind (180), so that the forward
+  // direction is fired mid-sweep.
+  bool clockwise = true;
+  double sweep_start_azimuth_deg = 180.0;
   double range_noise_stddev = 0.02;  // metres (simulator)
 
   // The HDL-64E S2 table: an upper block of 32 lasers from +2 deg to -8.33 deg and a lower block of
@@ -122,6 +134,21 @@ struct ModelConfig {
   MotionPrior motion_prior = MotionPrior::constant_acceleration;
 };
 
+// Motion compensation (docs/deskew.md): every point is moved from the sensor frame of its firing instant
+// to the scan's reference instant, under the sensor's velocity over the sweep. The reference instant is
+// the cloud's stamp for `field` (time 0) and mid-sweep for `azimuth` (when the sensor faces the azimuth
+// opposite the sweep's start: forward, for KITTI, whose ground truth refers to that instant).
+struct DeskewConfig {
+  // `field` is what ROS drivers deliver: Velodyne `time`, Ouster `t`, Hesai `timestamp`. A cloud without
+  // usable times is processed as instantaneous, and counted (Odometry::warningCounts()).
+  TimeSource time_source = TimeSource::field;
+  // After the first registration (deskewed with the motion prior's velocity), each round deskews again
+  // with the registered motion and registers again from the registered pose. One round brings the
+  // deskew to the registered motion; further rounds change it by what one round changed the pose,
+  // which is the prior's error times the sweep over the scan interval (docs/deskew.md).
+  int rounds = 1;
+};
+
 struct RuntimeConfig {
   BackendKind backend = BackendKind::cpu;
   // With backend cuda and no usable GPU: run on the CPU backend with a warning instead of failing.
@@ -136,6 +163,7 @@ struct Config {
   BevConfig bev;
   RegistrationConfig registration;
   ModelConfig model;
+  DeskewConfig deskew;
   RuntimeConfig runtime;
 };
 

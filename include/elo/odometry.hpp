@@ -18,7 +18,8 @@ namespace elo {
 struct StageTimes {
   double projection = 0.0;
   double feature_extraction = 0.0;  // ground segmentation + normals + BEV map
-  double registration = 0.0;
+  double registration = 0.0;  // every round's registration (deskew.rounds)
+  double deskew = 0.0;  // deskewing the scan again in place and rebuilding its ground map, over the rounds
   double model_update = 0.0;
   double total = 0.0;
 };
@@ -32,7 +33,14 @@ struct FrameResult {
   bool gap_restart = false;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // sensor in the odometry frame
   Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();  // T^{t-1}_t
-  RegistrationResult registration;
+  RegistrationResult registration;  // of the last round
+  // Motion compensation (docs/deskew.md): where the points' times came from (none: the scan was taken as
+  // instantaneous), the rounds of deskewing again with the registered motion, and why the cloud's own
+  // times were not used or not all used (empty when they were, or when none were asked for).
+  TimeSource time_source = TimeSource::none;
+  int deskew_rounds = 0;
+  std::string time_warning;
+  size_t points_without_time = 0;  // points dropped for a time outside the sweep
   StageTimes times;
 };
 
@@ -60,6 +68,8 @@ class Odometry {
   const std::map<std::string, size_t>& skippedCounts() const { return skipped_; }
   // Scans registered with at least one degenerate direction (RegistrationResult::degeneracy).
   size_t degenerateCount() const { return degenerate_; }
+  // Scans whose per-point times were not used, or not all used, by FrameResult::time_warning.
+  const std::map<std::string, size_t>& timeWarningCounts() const { return time_warnings_; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -75,6 +85,10 @@ class Odometry {
   void restartModel();
   // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
   void followTimeline(double stamp, FrameResult& result);
+  // Registers the projected scan from `guess`, then deskews it again with the registered motion and
+  // registers again, deskew.rounds times (docs/deskew.md); against a provisional model, deskews once
+  // and keeps the first registration.
+  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;
@@ -82,11 +96,17 @@ class Odometry {
   MotionModel motion_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   bool started_ = false;
+  // The model holds only the first scan of a start, which had per-point times but no motion to deskew
+  // them with: the next registered scan, deskewed with its registered motion, replaces it instead of
+  // joining it. Fused, its distorted points would stay (the oldest point on a surface does) and bias
+  // the registrations of the next model.time_window seconds.
+  bool model_provisional_ = false;
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
   size_t processed_ = 0;
   size_t degenerate_ = 0;
   std::map<std::string, size_t> skipped_;
+  std::map<std::string, size_t> time_warnings_;
 };
 
 }  // namespace elo

@@ -18,8 +18,10 @@ struct PointCloud {
   std::vector<Vec3f> points;
   std::vector<float> intensity;  // empty, or one per point
   std::vector<uint16_t> ring;    // empty, or the beam index of each point (0 = top beam)
-  std::vector<float> time;       // empty, or each point's time offset within the sweep (s)
-  double stamp = 0.0;            // acquisition time of the sweep (s)
+  // Empty, or each point's firing time (s) relative to `stamp`: negative before it, positive after it
+  // (docs/deskew.md). The odometry deskews by these with deskew.time_source `field`.
+  std::vector<float> time;
+  double stamp = 0.0;            // acquisition time of the sweep (s): the reference instant of `time`
 
   size_t size() const { return points.size(); }
 };
@@ -54,9 +56,14 @@ struct SphericalImage {
 
 // The scan after projection: which cloud point each pixel holds and its label.
 struct ScanImage {
-  SphericalImage image;           // every projected point; normals only on non-ground pixels
+  SphericalImage image;           // every projected point, deskewed; normals only on non-ground pixels
   std::vector<int32_t> point_index;  // cloud index per pixel, -1 when empty
   std::vector<PixelLabel> label;
+  // Per occupied pixel, so that the scan can be deskewed again in place: its point as measured (after
+  // the elevation correction, in the sensor frame of its firing instant) and its firing time relative
+  // to the scan's reference instant (s).
+  std::vector<Vec3f> measured;
+  std::vector<float> time;
 
   void resize(int rows, int cols);
 };

@@ -111,7 +111,12 @@ std::vector<Parameter> parameters(Config& c) {
            "nominal beam elevations top to bottom, deg; empty = beam_count beams spread evenly"),
       bindField("sensor.beam_count", s.beam_count, "number of beams"),
       bindField("sensor.azimuth_steps", s.azimuth_steps, "firings per revolution (simulator)"),
-      bindField("sensor.rotation_rate_hz", s.rotation_rate_hz, "revolutions per second (simulator)"),
+      bindField("sensor.rotation_rate_hz", s.rotation_rate_hz,
+                "revolutions per second (simulator, azimuth times, window of per-point times)"),
+      bindField("sensor.clockwise", s.clockwise, "the sensor turns clockwise seen from above (azimuth times, simulator)"),
+      bindField("sensor.sweep_start_azimuth_deg", s.sweep_start_azimuth_deg,
+                "azimuth where each sweep starts, deg counter-clockwise from x; 180 = straight behind (azimuth "
+                "times, simulator)"),
       bindField("sensor.range_noise_stddev", s.range_noise_stddev, "range noise, m (simulator)"),
       bindField("ground.sensor_height", g.sensor_height, "h_g: sensor height above the road, m (Sec. III-C.1)"),
       bindField("ground.band_above", g.band_above, "delta_h1: ground band above the road height, m (Sec. III-C.1)"),
@@ -169,6 +174,12 @@ std::vector<Parameter> parameters(Config& c) {
                   {MotionPrior::constant_velocity, "constant_velocity"},
                   {MotionPrior::none, "none"}},
                  "initial guess of the registration (Sec. III-A)"),
+      bindChoice("deskew.time_source", c.deskew.time_source,
+                 {{TimeSource::none, "none"}, {TimeSource::field, "field"}, {TimeSource::azimuth, "azimuth"}},
+                 "per-point firing times for motion compensation: none (instantaneous scans), field (the cloud's "
+                 "times, relative to its stamp), azimuth (from each point's azimuth; reference mid-sweep)"),
+      bindField("deskew.rounds", c.deskew.rounds,
+                "deskew-and-register rounds after the first registration, each with the motion just registered"),
       bindChoice("runtime.backend", c.runtime.backend,
                  {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
       bindField("runtime.backend_fallback", c.runtime.backend_fallback,
@@ -238,6 +249,8 @@ void validate(const Config& c) {
 
   require(c.model.time_window > 0.0, "model.time_window", "must be positive");
   require(c.model.same_surface_distance >= 0.0, "model.same_surface_distance", "must not be negative");
+  require(std::isfinite(s.sweep_start_azimuth_deg), "sensor.sweep_start_azimuth_deg", "must be finite");
+  require(c.deskew.rounds >= 0 && c.deskew.rounds <= 5, "deskew.rounds", "must lie in [0, 5]");
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
 }
 

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "elo/deskew.hpp"
+
 namespace elo {
 
 namespace {
@@ -58,6 +60,28 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
+void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, FrameResult& result) {
+  const bool informed = motion_.informed();
+  auto stage_start = Clock::now();
+  result.registration = registerScan(*backend_, guess, informed, config_.registration);
+  result.times.registration = millisecondsSince(stage_start);
+  if (result.time_source == TimeSource::none) return;
+  for (int round = 0; round < config_.deskew.rounds && !result.registration.failed; ++round) {
+    stage_start = Clock::now();
+    backend_->deskewScan(sweepVelocity(result.registration.model_from_scan, dt));
+    backend_->buildGroundMap();
+    backend_->synchronize();
+    result.times.deskew += millisecondsSince(stage_start);
+    ++result.deskew_rounds;
+    // Against a model of the first scan as measured, the scan as measured registers best (the two are
+    // bent alike): deskewed, it only replaces that model.
+    if (model_provisional_) break;
+    stage_start = Clock::now();
+    result.registration = registerScan(*backend_, result.registration.model_from_scan, informed, config_.registration);
+    result.times.registration += millisecondsSince(stage_start);
+  }
+}
+
 FrameResult Odometry::process(const PointCloud& cloud) {
   if (cloud.points.empty()) return skip("empty cloud");
   if (!std::isfinite(cloud.stamp)) return skip("stamp not finite");
@@ -69,14 +93,23 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   const auto frame_start = Clock::now();
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
   const float relative_stamp = static_cast<float>(cloud.stamp - first_stamp_);
+  const CloudTimes times = inspectTimes(cloud, config_);
+  result.time_source = times.source;
+  result.time_warning = times.warning;
+  result.points_without_time = times.outside_sweep;
+  if (!times.warning.empty()) ++time_warnings_[times.warning];
+  const double dt = started_ ? cloud.stamp - last_stamp_ : 0.0;
+  const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp);
+  // Deskewed under the prior's velocity: the first scans (no prior yet) as they were measured.
+  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweepVelocity(guess, dt)});
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
     skipped.reset = result.reset;
     skipped.gap_restart = result.gap_restart;
+    skipped.time_warning = result.time_warning;
     return skipped;
   }
 
@@ -88,10 +121,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
-    const double dt = cloud.stamp - last_stamp_;
-    stage_start = Clock::now();
-    result.registration = registerScan(*backend_, motion_.predict(dt), motion_.informed(), config_.registration);
-    result.times.registration = millisecondsSince(stage_start);
+    registerAndDeskew(guess, dt, result);
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;
     motion_.record(result.delta, dt);
@@ -103,6 +133,8 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   }
 
   stage_start = Clock::now();
+  if (model_provisional_) backend_->resetModel();
+  model_provisional_ = !started_ && times.source != TimeSource::none;
   backend_->updateModel(result.delta, relative_stamp);
   backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);

@@ -29,6 +29,8 @@ void ScanImage::resize(int rows, int cols) {
   image.resize(rows, cols);
   point_index.assign(image.pixelCount(), -1);
   label.assign(image.pixelCount(), PixelLabel::empty);
+  measured.assign(image.pixelCount(), Vec3f::Zero());
+  time.assign(image.pixelCount(), 0.0f);
 }
 
 void BevImage::resize(int grid_rows, int grid_cols) {

@@ -76,10 +76,18 @@ struct FieldReader {
   }
 };
 
+// How a driver's per-point times become PointCloud::time, seconds relative to the header stamp.
+struct TimeReader {
+  FieldReader field;
+  double scale = 1.0;   // seconds per stored unit
+  double offset = 0.0;  // subtracted after scaling: the header stamp, for absolute times
+};
+
 struct Layout {
   FieldReader x, y, z;
-  std::optional<FieldReader> intensity, ring, time;
-  double time_scale = 1.0;  // seconds per stored unit
+  std::optional<FieldReader> intensity, ring;
+  std::optional<TimeReader> time;
+  std::string time_problem;  // why a time field present was not read; empty otherwise
 };
 
 struct Rejection {
@@ -107,8 +115,46 @@ std::optional<Rejection> checkField(const PointField& field, uint32_t point_step
   return std::nullopt;
 }
 
-// Finds x, y, z and the optional fields. An optional field that is present but unusable rejects the
-// cloud too: a misread ring would silently corrupt the projection.
+// The drivers' per-point time conventions (docs/deskew.md), in this order of preference:
+//   `time`      float32/float64 s relative to the header stamp (Velodyne: negative, the stamp ends the sweep)
+//   `t`         uint32/int32 ns from the sweep's start, which the header stamp is (Ouster)
+//   `timestamp` float64 absolute s (Hesai, RoboSense): the header stamp is subtracted
+// A time field of another type cannot hold a sweep's times (an 8- or 16-bit count of nanoseconds, an
+// absolute time in float32, to two minutes): the cloud is read without times and `time_problem` says
+// why, so that the scan is still used, as an instantaneous one.
+void findTimes(const sensor_msgs::PointCloud2& message, bool swap_bytes, Layout& layout) {
+  struct Convention {
+    const char* name;
+    bool (*accepts)(uint8_t datatype);
+    double scale;
+    bool absolute;
+    const char* expected;
+  };
+  static const Convention kConventions[] = {
+      {"time", isFloatingPoint, 1.0, false, "float32 or float64 seconds relative to the header stamp"},
+      {"t", [](uint8_t type) { return type == PointField::UINT32 || type == PointField::INT32; }, 1e-9, false,
+       "uint32 nanoseconds from the header stamp"},
+      {"timestamp", [](uint8_t type) { return type == PointField::FLOAT64; }, 1.0, true, "float64 absolute seconds"},
+  };
+  for (const Convention& convention : kConventions) {
+    const PointField* field = findField(message, convention.name);
+    if (field == nullptr) continue;
+    if (auto problem = checkField(*field, message.point_step)) {
+      layout.time_problem = problem->detail + "; the cloud is read without per-point times";
+    } else if (!convention.accepts(field->datatype)) {
+      layout.time_problem = "field '" + field->name + "' is " + datatypeName(field->datatype) + ", not " +
+                            convention.expected + "; the cloud is read without per-point times";
+    } else {
+      layout.time = TimeReader{FieldReader{field->offset, field->datatype, swap_bytes}, convention.scale,
+                               convention.absolute ? message.header.stamp.toSec() : 0.0};
+    }
+    return;
+  }
+}
+
+// Finds x, y, z and the optional fields. An unusable intensity or ring field rejects the cloud too: a
+// misread ring would silently corrupt the projection. An unusable time field only loses the times
+// (findTimes()).
 std::optional<Rejection> findLayout(const sensor_msgs::PointCloud2& message, Layout& layout) {
   const bool swap_bytes = message.is_bigendian != hostIsBigEndian();
   FieldReader* coordinates[] = {&layout.x, &layout.y, &layout.z};
@@ -125,9 +171,7 @@ std::optional<Rejection> findLayout(const sensor_msgs::PointCloud2& message, Lay
   }
   const PointField* intensity = findField(message, "intensity");
   const PointField* ring = findField(message, "ring");
-  const PointField* time = findField(message, "time");
-  if (time == nullptr) time = findField(message, "t");
-  for (const PointField* field : {intensity, ring, time}) {
+  for (const PointField* field : {intensity, ring}) {
     if (field == nullptr) continue;
     if (auto rejection = checkField(*field, message.point_step)) return rejection;
   }
@@ -137,10 +181,7 @@ std::optional<Rejection> findLayout(const sensor_msgs::PointCloud2& message, Lay
   }
   if (intensity != nullptr) layout.intensity = FieldReader{intensity->offset, intensity->datatype, swap_bytes};
   if (ring != nullptr) layout.ring = FieldReader{ring->offset, ring->datatype, swap_bytes};
-  if (time != nullptr) {
-    layout.time = FieldReader{time->offset, time->datatype, swap_bytes};
-    if (!isFloatingPoint(time->datatype)) layout.time_scale = 1e-9;  // integer times are nanoseconds (Ouster)
-  }
+  findTimes(message, swap_bytes, layout);
   return std::nullopt;
 }
 
@@ -179,7 +220,9 @@ void appendPoint(const uint8_t* point, const elo::Vec3f& position, const Layout&
   cloud.points.push_back(position);
   if (layout.intensity) cloud.intensity.push_back(static_cast<float>(layout.intensity->read(point)));
   if (layout.ring) cloud.ring.push_back(elo::ringFromValue(layout.ring->read(point)));
-  if (layout.time) cloud.time.push_back(static_cast<float>(layout.time_scale * layout.time->read(point)));
+  if (layout.time) {
+    cloud.time.push_back(static_cast<float>(layout.time->scale * layout.time->field.read(point) - layout.time->offset));
+  }
 }
 
 // Appends a float32 or uint16 field at the next offset aligned to its size, as a C struct would.
@@ -227,6 +270,7 @@ ConvertedCloud fromPointCloud2(const sensor_msgs::PointCloud2& message) {
   if (auto rejection = checkExtent(message)) return rejected(std::move(*rejection));
 
   ConvertedCloud converted;
+  converted.time_problem = layout.time_problem;
   elo::PointCloud& cloud = converted.cloud;
   cloud.stamp = message.header.stamp.toSec();
   const size_t capacity = static_cast<size_t>(message.width) * message.height;

@@ -32,12 +32,17 @@ struct ConvertedCloud {
   size_t non_finite_points = 0;
   CloudProblem problem = CloudProblem::none;
   std::string detail;  // the problem in words, naming the field or the sizes; empty when usable
+  // Why the cloud's per-point time field was not read (its type cannot hold a sweep's times); the cloud
+  // is still usable, without times. Empty when there is no time field or it was read.
+  std::string time_problem;
 
   bool usable() const { return problem == CloudProblem::none; }
 };
 
 // Reads x, y, z (float32 or float64) and, when present, `intensity` (any numeric type), `ring` (any
-// integer type) and `time`, else `t` (floating point: seconds; integer: nanoseconds, as Ouster writes).
+// integer type) and the per-point times of the first of `time` (float seconds relative to the header
+// stamp, Velodyne), `t` (uint32 nanoseconds from the header stamp, Ouster) and `timestamp` (float64
+// absolute seconds, Hesai), as elo::PointCloud::time: seconds relative to the header stamp.
 // Any point_step, row padding, organized or not, either byte order. The stamp is the header's.
 ConvertedCloud fromPointCloud2(const sensor_msgs::PointCloud2& message);
 

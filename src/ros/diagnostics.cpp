@@ -23,6 +23,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(skipped, "skipped");
   add(failed_registrations, "registrations failed");
   add(restarts, "odometry restarts");
+  add(time_warnings, "scans with unusable per-point times");
   return text.str();
 }
 
@@ -73,6 +74,10 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
   if (result.registration.degeneracy.any()) {
     ++degenerate_scans_;
   }
+  if (!result.time_warning.empty()) {
+    ++time_warnings_[result.time_warning];
+    ++window_.time_warnings;
+  }
   if (result.registration.iterations > 0) last_registration_ = result.registration;
 }
 
@@ -116,6 +121,7 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   for (const auto& [reason, count] : rejected_) status.add("clouds rejected: " + reason, count);
   for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
   for (const auto& [reason, count] : restarts_) status.add("odometry restarts: " + reason, count);
+  for (const auto& [reason, count] : time_warnings_) status.add("per-point times: " + reason, count);
 
   window_start_ = now;
   window_ = Window();

@@ -30,7 +30,8 @@ class PipelineStatistics {
   void odometryRestarted(const std::string& reason);
 
   // Fills `status` and starts a new window. WARN when the window saw no cloud at all, or a drop,
-  // rejection, skip, restart or failed registration, and while the latest scan is degenerate.
+  // rejection, skip, restart, failed registration or scan whose per-point times were not (all) usable
+  // (elo::FrameResult::time_warning), and while the latest scan is degenerate.
   void report(diagnostic_updater::DiagnosticStatusWrapper& status);
 
  private:
@@ -44,6 +45,7 @@ class PipelineStatistics {
     size_t skipped = 0;
     size_t failed_registrations = 0;
     size_t restarts = 0;
+    size_t time_warnings = 0;
     double processing_ms_sum = 0.0;
     double processing_ms_max = 0.0;
     double latency_ms_sum = 0.0;
@@ -64,6 +66,7 @@ class PipelineStatistics {
   std::map<std::string, size_t> rejected_;
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> restarts_;
+  std::map<std::string, size_t> time_warnings_;  // elo::FrameResult::time_warning
   elo::RegistrationResult last_registration_;
 };
 

@@ -163,6 +163,10 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
     return;
   }
   if (!bindFrames(message.header.frame_id)) return;
+  if (!converted.time_problem.empty() && odometry_->config().deskew.time_source == elo::TimeSource::field) {
+    // The core counts the scan as one without usable times (elo::FrameResult::time_warning).
+    NODELET_WARN_THROTTLE(kWarningPeriod, "%s", converted.time_problem.c_str());
+  }
 
   std::unique_lock<std::mutex> lock(odometry_mutex_);
   const elo::FrameResult result = odometry_->process(converted.cloud);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
+#include "elo/se3.hpp"
 #include "elo/sensor_model.hpp"
 #include "elo/types.hpp"
 
@@ -107,6 +108,7 @@ struct ScanWithTruth {
   std::vector<Surface> surface;          // per point
   std::vector<Eigen::Vector3d> normal;   // per point, sensor frame
   std::vector<double> edge_distance;     // per point: to the nearest edge of its face or box footprint
+  std::vector<int> step;                 // per point: the azimuth step that fired it
 };
 
 // Gaussian samples from the raw output of a fixed generator (Box-Muller), so the same seed gives the
@@ -124,17 +126,18 @@ class GaussianNoise {
   std::mt19937 engine_;
 };
 
-// Fires every beam of `sensor` at `azimuth_steps` azimuths from `world_from_sensor`, adding Gaussian
-// range noise of `range_noise` metres.
-inline ScanWithTruth scanScene(const Scene& scene, const SensorConfig& sensor,
-                               const Eigen::Isometry3d& world_from_sensor, double stamp = 0.0,
-                               double range_noise = 0.0, uint32_t seed = 1) {
+// Fires every beam of `sensor` at `azimuth_steps` azimuths, clockwise from straight behind, step k from
+// `world_from_sensor_at(k)`, adding Gaussian range noise of `range_noise` metres.
+template <typename PoseOfStep>
+ScanWithTruth scanSceneFrom(const Scene& scene, const SensorConfig& sensor, const PoseOfStep& world_from_sensor_at,
+                            double stamp, double range_noise, uint32_t seed) {
   ScanWithTruth scan;
   GaussianNoise noise(seed);
   scan.cloud.stamp = stamp;
-  const Eigen::Matrix3d rotation = world_from_sensor.linear();
   const std::vector<float> elevations = beamElevations(sensor);
   for (int step = 0; step < sensor.azimuth_steps; ++step) {
+    const Eigen::Isometry3d world_from_sensor = world_from_sensor_at(step);
+    const Eigen::Matrix3d rotation = world_from_sensor.linear();
     const double azimuth = M_PI - 2.0 * M_PI * (step + 0.5) / sensor.azimuth_steps;
     for (size_t beam = 0; beam < elevations.size(); ++beam) {
       const double elevation = elevations[beam];
@@ -145,6 +148,7 @@ inline ScanWithTruth scanScene(const Scene& scene, const SensorConfig& sensor,
       const double range = hit.range + (range_noise > 0.0 ? range_noise * noise() : 0.0);
       scan.cloud.points.push_back((local * range).cast<float>());
       scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
+      scan.step.push_back(step);
       scan.surface.push_back(hit.surface);
       scan.normal.push_back(rotation.transpose() * hit.normal);
       const Eigen::Vector3d world_point = world_from_sensor.translation() + rotation * local * hit.range;
@@ -152,6 +156,32 @@ inline ScanWithTruth scanScene(const Scene& scene, const SensorConfig& sensor,
                                            : distanceToFootprints(scene.boxes, world_point));
     }
   }
+  return scan;
+}
+
+// An instantaneous scan from `world_from_sensor`.
+inline ScanWithTruth scanScene(const Scene& scene, const SensorConfig& sensor,
+                               const Eigen::Isometry3d& world_from_sensor, double stamp = 0.0,
+                               double range_noise = 0.0, uint32_t seed = 1) {
+  return scanSceneFrom(scene, sensor, [&](int) { return world_from_sensor; }, stamp, range_noise, seed);
+}
+
+// The firing time of azimuth step `step` relative to mid-sweep, the reference instant of KITTI's HDL-64E
+// (clockwise from straight behind, sensor.rotation_rate_hz).
+inline double firingTime(const SensorConfig& sensor, int step) {
+  return ((step + 0.5) / sensor.azimuth_steps - 0.5) / sensor.rotation_rate_hz;
+}
+
+// A sweep from a sensor moving at the constant twist `velocity` (per second; translation, rotation; in
+// its frame at the reference instant): step k fires from world_from_reference * exp(t_k velocity), at
+// t_k = firingTime(k), which every point carries in `time`.
+inline ScanWithTruth sweepScene(const Scene& scene, const SensorConfig& sensor,
+                                const Eigen::Isometry3d& world_from_reference, const Vector6d& velocity,
+                                double stamp = 0.0) {
+  ScanWithTruth scan = scanSceneFrom(
+      scene, sensor, [&](int step) { return world_from_reference * expSE3(firingTime(sensor, step) * velocity); },
+      stamp, 0.0, 1);
+  for (int step : scan.step) scan.cloud.time.push_back(static_cast<float>(firingTime(sensor, step)));
   return scan;
 }
 

@@ -100,6 +100,28 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   EXPECT_NE(message_of(config).find("bev.cell_size"), std::string::npos);
 }
 
+TEST(Config, DeskewKeysSetTheTimeSourceAndTheSweep) {
+  Config config;
+  EXPECT_EQ(config.deskew.time_source, TimeSource::field);
+  EXPECT_TRUE(config.sensor.clockwise);
+  EXPECT_DOUBLE_EQ(config.sensor.sweep_start_azimuth_deg, 180.0);
+  for (const Parameter& parameter : parameters(config)) {
+    if (parameter.key == "deskew.time_source") {
+      setFromString(parameter, "azimuth");
+      EXPECT_THROW(setFromString(parameter, "lidar"), ConfigError);
+    }
+    if (parameter.key == "deskew.rounds") setFromString(parameter, "2");
+    if (parameter.key == "sensor.clockwise") setFromString(parameter, "false");
+    if (parameter.key == "sensor.sweep_start_azimuth_deg") setFromString(parameter, "90");
+  }
+  EXPECT_EQ(config.deskew.time_source, TimeSource::azimuth);
+  EXPECT_EQ(config.deskew.rounds, 2);
+  EXPECT_FALSE(config.sensor.clockwise);
+  EXPECT_DOUBLE_EQ(config.sensor.sweep_start_azimuth_deg, 90.0);
+  config.deskew.rounds = -1;
+  EXPECT_THROW(validate(config), ConfigError);
+}
+
 TEST(Config, EveryParameterIsDocumentedInTheReadme) {
   std::ifstream file(std::string(ELO_SOURCE_DIR) + "/README.md");
   ASSERT_TRUE(file) << "README.md not found";

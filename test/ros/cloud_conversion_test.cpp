@@ -161,6 +161,51 @@ TEST(CloudConversion, FloatTimeInSecondsPreferredOverT) {
   EXPECT_EQ(converted.cloud.time, (std::vector<float>{0.025f}));
 }
 
+// Velodyne stamps a sweep at its last packet: times are negative, relative to the header stamp, and stay so.
+TEST(CloudConversion, VelodyneTimesStayRelativeToTheStamp) {
+  std::vector<FieldSpec> fields = kXyzFloat;
+  fields.push_back({"time", 12, PointField::FLOAT32});
+  sensor_msgs::PointCloud2 message = makeMessage(fields, 16, 2);
+  put(pointAt(message, 0, 0), 12, -0.0999f);
+  put(pointAt(message, 0, 1), 12, -0.0001f);
+  const elo_ros::ConvertedCloud converted = elo_ros::fromPointCloud2(message);
+  ASSERT_TRUE(converted.usable()) << converted.detail;
+  EXPECT_EQ(converted.cloud.time, (std::vector<float>{-0.0999f, -0.0001f}));
+  EXPECT_TRUE(converted.time_problem.empty());
+}
+
+// Hesai (and RoboSense) write absolute float64 seconds: the header stamp is subtracted.
+TEST(CloudConversion, AbsoluteTimestampsBecomeRelativeToTheStamp) {
+  std::vector<FieldSpec> fields = kXyzFloat;
+  fields.push_back({"timestamp", 16, PointField::FLOAT64});
+  sensor_msgs::PointCloud2 message = makeMessage(fields, 24, 2);
+  const double stamp = message.header.stamp.toSec();  // 1234.5
+  put(pointAt(message, 0, 0), 16, stamp - 0.1);
+  put(pointAt(message, 0, 1), 16, stamp + 0.025);
+  const elo_ros::ConvertedCloud converted = elo_ros::fromPointCloud2(message);
+  ASSERT_TRUE(converted.usable()) << converted.detail;
+  ASSERT_EQ(converted.cloud.time.size(), 2u);
+  EXPECT_NEAR(converted.cloud.time[0], -0.1f, 1e-9f);
+  EXPECT_NEAR(converted.cloud.time[1], 0.025f, 1e-9f);
+}
+
+// A time field whose type cannot hold a sweep's times loses the times, not the cloud, and says why.
+TEST(CloudConversion, ATimeFieldOfTheWrongTypeIsLeftOutWithTheReason) {
+  const std::pair<const char*, uint8_t> wrong[] = {
+      {"time", PointField::UINT16}, {"t", PointField::UINT16}, {"t", PointField::FLOAT32},
+      {"timestamp", PointField::FLOAT32}};
+  for (const auto& [name, datatype] : wrong) {
+    std::vector<FieldSpec> fields = kXyzFloat;
+    fields.push_back({name, 12, datatype});
+    const elo_ros::ConvertedCloud converted = elo_ros::fromPointCloud2(makeMessage(fields, 16, 3));
+    ASSERT_TRUE(converted.usable()) << name << ": " << converted.detail;
+    EXPECT_EQ(converted.cloud.size(), 3u);
+    EXPECT_TRUE(converted.cloud.time.empty()) << name;
+    EXPECT_NE(converted.time_problem.find(std::string("'") + name + "'"), std::string::npos) << converted.time_problem;
+    EXPECT_NE(converted.time_problem.find("without per-point times"), std::string::npos) << converted.time_problem;
+  }
+}
+
 TEST(CloudConversion, ReadsFloat64Coordinates) {
   const std::vector<FieldSpec> fields = {
       {"x", 0, PointField::FLOAT64}, {"y", 8, PointField::FLOAT64}, {"z", 16, PointField::FLOAT64},

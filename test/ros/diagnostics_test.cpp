@@ -67,6 +67,19 @@ TEST(RosDiagnostics, RestartsWarnAndAreCountedByReason) {
   EXPECT_EQ(valueOf(status, "odometry restarts: gap longer than model.time_window"), "1");
 }
 
+TEST(RosDiagnostics, UnusablePerPointTimesWarnAndAreCountedByReason) {
+  elo_ros::PipelineStatistics statistics;
+  elo::FrameResult instantaneous = processedScan(60.0);
+  instantaneous.time_warning = "no per-point times: taken as instantaneous";
+  statistics.cloudReceived();
+  statistics.scanProcessed(instantaneous, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  statistics.report(status);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(status.message.find("1 scans with unusable per-point times"), std::string::npos) << status.message;
+  EXPECT_EQ(valueOf(status, "per-point times: no per-point times: taken as instantaneous"), "1");
+}
+
 TEST(RosDiagnostics, DegenerateScansWarnWhileTheyLastAndAreCounted) {
   elo_ros::PipelineStatistics statistics;
   elo::FrameResult tunnel = processedScan(60.0);

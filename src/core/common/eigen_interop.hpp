@@ -4,7 +4,10 @@
 
 #include <Eigen/Geometry>
 
+#include "core/common/deskew.hpp"
+#include "elo/backend.hpp"  // SweepMotion
 #include "elo/device_types.hpp"
+#include "elo/types.hpp"
 
 namespace elo {
 
@@ -19,6 +22,20 @@ inline Rigid3f toRigid3f(const Eigen::Isometry3d& transform) {
   rigid.t = {static_cast<float>(transform.translation().x()), static_cast<float>(transform.translation().y()),
              static_cast<float>(transform.translation().z())};
   return rigid;
+}
+
+inline SweepVelocity toSweepVelocity(const Vector6d& twist) {
+  return {{static_cast<float>(twist(0)), static_cast<float>(twist(1)), static_cast<float>(twist(2))},
+          {static_cast<float>(twist(3)), static_cast<float>(twist(4)), static_cast<float>(twist(5))}};
+}
+
+// The deskew of `cloud`'s projection under `motion` (Backend::projectScan()): per-point times from the
+// cloud only when it has one for every point, else none.
+inline SweepDeskew sweepDeskew(const SensorConfig& sensor, const PointCloud& cloud, const SweepMotion& motion) {
+  const bool has_times = cloud.time.size() == cloud.points.size();
+  const TimeSource source = motion.times == TimeSource::field && !has_times ? TimeSource::none : motion.times;
+  return {SweepTiming::fromConfig(sensor, source), source == TimeSource::field ? cloud.time.data() : nullptr,
+          source == TimeSource::none ? SweepVelocity{} : toSweepVelocity(motion.velocity)};
 }
 
 }  // namespace elo

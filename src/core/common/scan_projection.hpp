@@ -2,30 +2,40 @@
 // closest point wins (closest_wins_key.hpp).
 #pragma once
 
+#include "core/common/deskew.hpp"
 #include "elo/projections.hpp"
 
 namespace elo {
 
 constexpr int kNoRing = -1;
 
-// The pixel of raw point `raw`, and the point after the elevation correction. `ring` (or kNoRing) is the
-// driver's beam index: when known, the beam's row (`ring_rows`, `ring_count` entries) is exact where the
-// elevation of a noisy point is not. False for a point that is not finite, out of range or out of the
-// image, or whose ring is not a known beam.
+// A cloud point as the projection places it.
+struct ScanPoint {
+  Float3 measured;  // after the elevation correction, in the sensor frame of its firing instant
+  Float3 vertex;    // deskewed to the scan's reference instant (deskew.hpp)
+  float time;       // its firing time relative to the reference instant (s)
+  int pixel;
+};
+
+// The pixel of cloud point `index` (`raw`), whose vertex is the point after the elevation correction and
+// the deskew. `ring` (or kNoRing) is the driver's beam index: when known, the beam's row (`ring_rows`,
+// `ring_count` entries) is exact where the elevation of a noisy point is not. False for a point that is
+// not finite, has no usable time, is out of range or out of the image, or whose ring is not a known beam.
 ELO_HOST_DEVICE inline bool scanPointPixel(const SphericalProjection& projection, const ElevationCorrection& correction,
-                                           const Float3& raw, int ring, const int* ring_rows, int ring_count,
-                                           Float3& corrected, int& pixel) {
+                                           const SweepDeskew& deskew, int index, const Float3& raw, int ring,
+                                           const int* ring_rows, int ring_count, ScanPoint& point) {
   if (!isFinite(raw)) return false;
-  corrected = correction.apply(raw);
+  point.measured = correction.apply(raw);
+  if (!deskew.apply(index, point.measured, point.time, point.vertex)) return false;
   int row = 0;
   int col = 0;
-  if (!projection.pixelOf(corrected, row, col)) return false;
+  if (!projection.pixelOf(point.vertex, row, col)) return false;
   if (ring != kNoRing) {
     if (ring >= ring_count) return false;
     row = ring_rows[ring];
     if (row < 0 || row >= projection.rows) return false;
   }
-  pixel = row * projection.cols + col;
+  point.pixel = row * projection.cols + col;
   return true;
 }
 

@@ -30,10 +30,22 @@ CpuBackend::CpuBackend(const Config& config)
   fusion_scratch_.resize(scan_.image.pixelCount());
 }
 
-size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp) {
+size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
+  const SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
+  scan_times_ = deskew.timing.source;
+  scan_velocity_ = deskew.velocity;
   size_t occupied = 0;
-  arena_.execute([&] { occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, stamp, winners_, scan_); });
+  arena_.execute([&] {
+    occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, scan_);
+  });
   return occupied;
+}
+
+void CpuBackend::deskewScan(const Vector6d& velocity) {
+  if (scan_times_ == TimeSource::none) return;
+  const SweepVelocity next = toSweepVelocity(velocity);
+  arena_.execute([&] { cpu::deskewScan(scan_velocity_, next, scan_); });
+  scan_velocity_ = next;
 }
 
 void CpuBackend::segmentGround() {

@@ -12,7 +12,8 @@ class CpuBackend final : public Backend {
   explicit CpuBackend(const Config& config);
 
   const char* name() const override { return "cpu"; }
-  size_t projectScan(const PointCloud& cloud, float stamp) override;
+  size_t projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) override;
+  void deskewScan(const Vector6d& velocity) override;
   void segmentGround() override;
   void estimateNormals() override;
   void buildGroundMap() override;
@@ -32,6 +33,9 @@ class CpuBackend final : public Backend {
   tbb::task_arena arena_;
 
   ScanImage scan_;
+  // The scan's deskew: whether its points have times, and the velocity its vertices are deskewed under.
+  TimeSource scan_times_ = TimeSource::none;
+  SweepVelocity scan_velocity_{};
   std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
   BevImage scan_ground_;
   Model model_;

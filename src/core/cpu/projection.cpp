@@ -1,5 +1,5 @@
-// Sec. III-B.1: spherical projection of the scan into an index range image, closest point per pixel. The
-// per-point math is shared with the CUDA backend (scan_projection.hpp).
+// Sec. III-B.1: spherical projection of the scan into an index range image, closest point per pixel, each
+// point deskewed first. The per-point math is shared with the CUDA backend (scan_projection.hpp).
 #include "core/common/eigen_interop.hpp"
 #include "core/common/scan_projection.hpp"
 #include "core/cpu/parallel.hpp"
@@ -8,19 +8,19 @@
 namespace elo::cpu {
 
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
-                    const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan) {
+                    const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
+                    ScanImage& scan) {
   const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
   const bool use_ring = !ring_rows.empty() && cloud.ring.size() == cloud.points.size();
+  const auto place = [&](size_t i, ScanPoint& point) {
+    const int ring = use_ring ? cloud.ring[i] : kNoRing;
+    return scanPointPixel(projection, correction, deskew, static_cast<int>(i), toFloat3(cloud.points[i]), ring,
+                          ring_rows.data(), static_cast<int>(ring_rows.size()), point);
+  };
   winners.reset();
   parallelFor(cloud.points.size(), [&](size_t i) {
-    Float3 corrected;
-    int pixel = 0;
-    const int ring = use_ring ? cloud.ring[i] : kNoRing;
-    if (!scanPointPixel(projection, correction, toFloat3(cloud.points[i]), ring, ring_rows.data(),
-                        static_cast<int>(ring_rows.size()), corrected, pixel)) {
-      return;
-    }
-    winners.offer(pixel, norm(corrected), static_cast<uint32_t>(i));
+    ScanPoint point;
+    if (place(i, point)) winners.offer(point.pixel, norm(point.vertex), static_cast<uint32_t>(i));
   });
 
   SphericalImage& image = scan.image;
@@ -34,10 +34,13 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
       return;
     }
     const uint32_t index = winners.winner(pixel);
-    const Float3 p = correction.apply(toFloat3(cloud.points[index]));
-    image.vertex[pixel] = toVec3f(p);
-    image.range[pixel] = norm(p);
+    ScanPoint point;
+    place(index, point);  // the winner's placement again: the same arithmetic, the same result
+    image.vertex[pixel] = toVec3f(point.vertex);
+    image.range[pixel] = norm(point.vertex);
     image.stamp[pixel] = stamp;
+    scan.measured[pixel] = toVec3f(point.measured);
+    scan.time[pixel] = point.time;
     scan.point_index[pixel] = static_cast<int32_t>(index);
     scan.label[pixel] = PixelLabel::nonground;
     occupied.fetch_add(1, std::memory_order_relaxed);

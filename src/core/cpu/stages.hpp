@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/common/deskew.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
@@ -15,10 +16,15 @@
 
 namespace elo::cpu {
 
-// projection.cpp: the closest point of the cloud per pixel; `ring_rows` maps a driver's ring index to
-// its row (empty: rows from the elevation). Returns the number of occupied pixels.
+// projection.cpp: the closest point of the cloud per pixel, every point deskewed by `deskew` first;
+// `ring_rows` maps a driver's ring index to its row (empty: rows from the elevation). Returns the number
+// of occupied pixels.
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
-                    const std::vector<int>& ring_rows, float stamp, ClosestWins& winners, ScanImage& scan);
+                    const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
+                    ScanImage& scan);
+
+// deskew.cpp: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
+void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
 
 // ground_segmentation.cpp: labels occupied pixels ground or non-ground, column by column.
 void segmentGround(const GroundConfig& config, ScanImage& scan);

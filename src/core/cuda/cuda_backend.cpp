@@ -82,6 +82,8 @@ void CudaBackend::allocate() {
   scan_image_.allocate(pixels_);
   point_indices_.reserve(pixels_);
   labels_.reserve(pixels_);
+  measured_.reserve(pixels_);
+  pixel_times_.reserve(pixels_);
   pixel_keys_.reserve(pixels_);
   closest_keys_.reserve(pixels_);
   registration_flags_.reserve(pixels_);
@@ -121,6 +123,8 @@ void CudaBackend::clearDevice() {
   }
   clear(point_indices_, pixels_, 0xff, stream);
   clear(labels_, pixels_, 0, stream);
+  clear(measured_, pixels_, 0, stream);
+  clear(pixel_times_, pixels_, 0, stream);
   for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1]}) {
     clear(map->point_of_cell, cells_, 0xff, stream);
   }
@@ -149,8 +153,9 @@ int CudaBackend::modelPoints() {
 }
 
 DeviceScan CudaBackend::deviceScan() const {
-  return {spherical_.rows,         spherical_.cols,        scan_image_.vertices.data(), scan_image_.normals.data(),
-          scan_image_.ranges.data(), scan_image_.stamps.data(), point_indices_.data(),  labels_.data()};
+  return {spherical_.rows,          spherical_.cols,           scan_image_.vertices.data(), scan_image_.normals.data(),
+          scan_image_.ranges.data(), scan_image_.stamps.data(), point_indices_.data(),       labels_.data(),
+          measured_.data(),          pixel_times_.data()};
 }
 
 DeviceModelImage CudaBackend::deviceModel(int buffer) const {
@@ -170,7 +175,7 @@ CellCompaction CudaBackend::compaction() const {
 }
 
 // Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
-void CudaBackend::upload(const PointCloud& cloud) {
+void CudaBackend::upload(const PointCloud& cloud, bool with_times) {
   const size_t count = cloud.points.size();
   uploaded_rings_ = !ring_rows_.empty() && cloud.ring.size() == count;
   staged_points_.reserve(count);
@@ -179,10 +184,15 @@ void CudaBackend::upload(const PointCloud& cloud) {
     staged_rings_.reserve(count);
     rings_.reserve(count);
   }
+  if (with_times) {
+    staged_times_.reserve(count);
+    times_.reserve(count);
+  }
   const Clock::time_point staging_start = Clock::now();
   if (count > 0) {
     std::memcpy(staged_points_.data(), cloud.points.data(), count * sizeof(Float3));
     if (uploaded_rings_) std::memcpy(staged_rings_.data(), cloud.ring.data(), count * sizeof(uint16_t));
+    if (with_times) std::memcpy(staged_times_.data(), cloud.time.data(), count * sizeof(float));
   }
   upload_milliseconds_ = std::chrono::duration<double, std::milli>(Clock::now() - staging_start).count();
   const cudaStream_t stream = stream_.get();
@@ -195,16 +205,26 @@ void CudaBackend::upload(const PointCloud& cloud) {
                             stream),
             "uploading the rings");
     }
+    if (with_times) {
+      check(cudaMemcpyAsync(times_.data(), staged_times_.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
+            "uploading the per-point times");
+    }
   }
   check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
 }
 
-size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp) {
-  upload(cloud);
+size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
+  SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
+  const bool with_times = deskew.timing.source == TimeSource::field;
+  upload(cloud, with_times);
+  deskew.times = with_times ? times_.data() : nullptr;
+  scan_times_ = deskew.timing.source;
+  scan_velocity_ = deskew.velocity;
   const UploadedCloud uploaded{points_.data(), uploaded_rings_ ? rings_.data() : nullptr,
                                static_cast<int>(cloud.points.size())};
-  cuda::projectScan(uploaded, spherical_, correction_, ring_rows_device_.data(), static_cast<int>(ring_rows_.size()),
-                    stamp, pixel_keys_.data(), deviceScan(), counts_.data() + kOccupiedPixels, stream_.get());
+  cuda::projectScan(uploaded, spherical_, correction_, deskew, ring_rows_device_.data(),
+                    static_cast<int>(ring_rows_.size()), stamp, pixel_keys_.data(), deviceScan(),
+                    counts_.data() + kOccupiedPixels, stream_.get());
   fetchCount(kOccupiedPixels);
   synchronize();  // the caller needs the count; the pinned staging buffer is free again after this
   float copy_milliseconds = 0.0f;
@@ -212,6 +232,14 @@ size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp) {
   upload_milliseconds_ += copy_milliseconds;
   scan_view_current_ = false;
   return static_cast<size_t>(host_counts_[kOccupiedPixels]);
+}
+
+void CudaBackend::deskewScan(const Vector6d& velocity) {
+  if (scan_times_ == TimeSource::none) return;
+  const SweepVelocity next = toSweepVelocity(velocity);
+  cuda::deskewScan(deviceScan(), scan_velocity_, next, stream_.get());
+  scan_velocity_ = next;
+  scan_view_current_ = false;
 }
 
 void CudaBackend::segmentGround() {
@@ -310,6 +338,8 @@ const ScanImage& CudaBackend::scan() {
   copyToHost(scan_view_.image.stamp, scan_image_.stamps.data(), pixels_, stream);
   copyToHost(scan_view_.point_index, point_indices_.data(), pixels_, stream);
   copyToHost(scan_view_.label, labels_.data(), pixels_, stream);
+  copyToHost(scan_view_.measured, measured_.data(), pixels_, stream);
+  copyToHost(scan_view_.time, pixel_times_.data(), pixels_, stream);
   synchronize();
   scan_view_current_ = true;
   return scan_view_;

@@ -18,7 +18,8 @@ class CudaBackend final : public Backend {
   explicit CudaBackend(const Config& config);
 
   const char* name() const override { return "cuda"; }
-  size_t projectScan(const PointCloud& cloud, float stamp) override;
+  size_t projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) override;
+  void deskewScan(const Vector6d& velocity) override;
   void segmentGround() override;
   void estimateNormals() override;
   void buildGroundMap() override;
@@ -57,7 +58,8 @@ class CudaBackend final : public Backend {
 
   void allocate();
   void clearDevice();
-  void upload(const PointCloud& cloud);
+  // Uploads the points, their rings when the projection uses them and their times when `with_times`.
+  void upload(const PointCloud& cloud, bool with_times);
   DeviceScan deviceScan() const;
   DeviceModelImage deviceModel(int buffer) const;
   DeviceBev deviceBev(const BevBuffers& buffers, int count) const;
@@ -90,14 +92,21 @@ class CudaBackend final : public Backend {
   // The cloud, staged in pinned memory.
   PinnedArray<Float3> staged_points_;
   PinnedArray<uint16_t> staged_rings_;
+  PinnedArray<float> staged_times_;
   DeviceArray<Float3> points_;
   DeviceArray<uint16_t> rings_;
+  DeviceArray<float> times_;
   DeviceArray<int> ring_rows_device_;
 
   // The scan image, its registration pixels and its ground map.
   SphericalBuffers scan_image_;
   DeviceArray<int32_t> point_indices_;
   DeviceArray<PixelLabel> labels_;
+  DeviceArray<Float3> measured_;
+  DeviceArray<float> pixel_times_;
+  // The scan's deskew: whether its points have times, and the velocity its vertices are deskewed under.
+  TimeSource scan_times_ = TimeSource::none;
+  SweepVelocity scan_velocity_{};
   DeviceArray<ClosestKey> pixel_keys_;
   DeviceArray<ClosestKey> closest_keys_;  // the model update's first round
   DeviceArray<int> registration_flags_;

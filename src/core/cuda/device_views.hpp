@@ -20,6 +20,8 @@ struct DeviceScan {
   float* stamps;
   int32_t* point_indices;  // cloud index per pixel, -1 when empty
   PixelLabel* labels;
+  Float3* measured;  // per pixel, its point as measured and its firing time (ScanImage)
+  float* times;
 
   ELO_HOST_DEVICE int pixels() const { return rows * cols; }
   ELO_HOST_DEVICE bool occupied(int pixel) const { return ranges[pixel] > 0.0f; }

@@ -10,6 +10,7 @@
 
 #include "core/common/association.hpp"
 #include "core/common/closest_wins_key.hpp"
+#include "core/common/deskew.hpp"
 #include "core/common/ground.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
@@ -47,16 +48,22 @@ struct FlaggedList {
 size_t exclusiveSumScratchBytes(int max_items);
 void exclusiveSum(const int* flags, int* offsets, int items, void* scratch, size_t scratch_bytes, cudaStream_t stream);
 
-// projection.cu: the closest point of the uploaded cloud per pixel (Sec. III-B.1); `rings` is null when
-// the cloud has no ring field. Counts the occupied pixels into `*occupied`.
+// projection.cu: the closest point of the uploaded cloud per pixel (Sec. III-B.1), each point deskewed
+// first; `rings` is null when the cloud has no ring field, and `deskew.times` points to the uploaded
+// times when the deskew needs them. Counts the occupied pixels into `*occupied`.
 struct UploadedCloud {
   const Float3* points;
   const uint16_t* rings;
   int count;
 };
 void projectScan(const UploadedCloud& cloud, const SphericalProjection& projection,
-                 const ElevationCorrection& correction, const int* ring_rows, int ring_count, float stamp,
-                 ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied, cudaStream_t stream);
+                 const ElevationCorrection& correction, const SweepDeskew& deskew, const int* ring_rows,
+                 int ring_count, float stamp, ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied,
+                 cudaStream_t stream);
+
+// deskew.cu: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
+void deskewScan(const DeviceScan& scan, const SweepVelocity& applied, const SweepVelocity& velocity,
+                cudaStream_t stream);
 
 // ground_segmentation.cu (Sec. III-C.1).
 void segmentGround(const DeviceScan& scan, const GroundBand& band, cudaStream_t stream);

@@ -1,6 +1,6 @@
-// Sec. III-B.1 on the GPU: every point offers itself to its pixel with an atomicMin of its closest-wins
-// key, then every pixel takes its winner. The per-point math is scanPointPixel() (scan_projection.hpp),
-// the same as the CPU backend's, so both fill the same pixels with the same points.
+// Sec. III-B.1 on the GPU: every point, deskewed, offers itself to its pixel with an atomicMin of its
+// closest-wins key, then every pixel takes its winner. The per-point math is scanPointPixel()
+// (scan_projection.hpp), the same as the CPU backend's, so both fill the same pixels with the same points.
 #include "core/common/scan_projection.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
@@ -9,19 +9,31 @@ namespace elo::cuda {
 
 namespace {
 
-__global__ void offerPoints(UploadedCloud cloud, SphericalProjection projection, ElevationCorrection correction,
-                            const int* ring_rows, int ring_count, ClosestKey* pixel_keys) {
+// How the kernels place a cloud point: the same for the offer and for the winner.
+struct PointPlacement {
+  UploadedCloud cloud;
+  SphericalProjection projection;
+  ElevationCorrection correction;
+  SweepDeskew deskew;
+  const int* ring_rows;
+  int ring_count;
+
+  __device__ bool place(int i, ScanPoint& point) const {
+    const int ring = cloud.rings != nullptr ? static_cast<int>(cloud.rings[i]) : kNoRing;
+    return scanPointPixel(projection, correction, deskew, i, cloud.points[i], ring, ring_rows, ring_count, point);
+  }
+};
+
+__global__ void offerPoints(PointPlacement placement, ClosestKey* pixel_keys) {
   const int i = globalThread();
-  if (i >= cloud.count) return;
-  const int ring = cloud.rings != nullptr ? static_cast<int>(cloud.rings[i]) : kNoRing;
-  Float3 corrected;
-  int pixel = 0;
-  if (!scanPointPixel(projection, correction, cloud.points[i], ring, ring_rows, ring_count, corrected, pixel)) return;
-  atomicMin(&pixel_keys[pixel], closestWinsKey(norm(corrected), static_cast<uint32_t>(i)));
+  if (i >= placement.cloud.count) return;
+  ScanPoint point;
+  if (!placement.place(i, point)) return;
+  atomicMin(&pixel_keys[point.pixel], closestWinsKey(norm(point.vertex), static_cast<uint32_t>(i)));
 }
 
-__global__ void takeWinners(const ClosestKey* pixel_keys, const Float3* points, ElevationCorrection correction,
-                            float stamp, DeviceScan scan, int* occupied) {
+__global__ void takeWinners(const ClosestKey* pixel_keys, PointPlacement placement, float stamp, DeviceScan scan,
+                            int* occupied) {
   const int pixel = globalThread();
   bool taken = false;
   if (pixel < scan.pixels()) {
@@ -33,10 +45,13 @@ __global__ void takeWinners(const ClosestKey* pixel_keys, const Float3* points, 
       scan.labels[pixel] = PixelLabel::empty;
     } else {
       const uint32_t index = closestWinsSource(key);
-      const Float3 point = correction.apply(points[index]);
-      scan.vertices[pixel] = point;
-      scan.ranges[pixel] = norm(point);
+      ScanPoint point;
+      placement.place(static_cast<int>(index), point);  // the winner's placement again: the same result
+      scan.vertices[pixel] = point.vertex;
+      scan.ranges[pixel] = norm(point.vertex);
       scan.stamps[pixel] = stamp;
+      scan.measured[pixel] = point.measured;
+      scan.times[pixel] = point.time;
       scan.point_indices[pixel] = static_cast<int32_t>(index);
       scan.labels[pixel] = PixelLabel::nonground;
       taken = true;
@@ -50,17 +65,17 @@ __global__ void takeWinners(const ClosestKey* pixel_keys, const Float3* points, 
 }  // namespace
 
 void projectScan(const UploadedCloud& cloud, const SphericalProjection& projection,
-                 const ElevationCorrection& correction, const int* ring_rows, int ring_count, float stamp,
-                 ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied, cudaStream_t stream) {
+                 const ElevationCorrection& correction, const SweepDeskew& deskew, const int* ring_rows,
+                 int ring_count, float stamp, ClosestKey* pixel_keys, const DeviceScan& scan, int* occupied,
+                 cudaStream_t stream) {
+  const PointPlacement placement{cloud, projection, correction, deskew, ring_rows, ring_count};
   check(cudaMemsetAsync(pixel_keys, 0xff, sizeof(ClosestKey) * scan.pixels(), stream), "clearing the pixel keys");
   check(cudaMemsetAsync(occupied, 0, sizeof(int), stream), "clearing the occupied count");
   if (cloud.count > 0) {
-    offerPoints<<<blocksFor(cloud.count), kThreads, 0, stream>>>(cloud, projection, correction, ring_rows, ring_count,
-                                                                 pixel_keys);
+    offerPoints<<<blocksFor(cloud.count), kThreads, 0, stream>>>(placement, pixel_keys);
     checkLaunch("offerPoints");
   }
-  takeWinners<<<blocksFor(scan.pixels()), kThreads, 0, stream>>>(pixel_keys, cloud.points, correction, stamp, scan,
-                                                                 occupied);
+  takeWinners<<<blocksFor(scan.pixels()), kThreads, 0, stream>>>(pixel_keys, placement, stamp, scan, occupied);
   checkLaunch("takeWinners");
 }
 

@@ -1,0 +1,33 @@
+// Motion compensation on the host side (docs/deskew.md): which times a cloud's points get, and the
+// velocity a scan is deskewed under. The per-point math is src/core/common/deskew.hpp.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+
+#include "elo/config.hpp"
+#include "elo/se3.hpp"
+#include "elo/types.hpp"
+
+namespace elo {
+
+// The times a cloud's points get, from deskew.time_source and what the cloud carries.
+struct CloudTimes {
+  TimeSource source = TimeSource::none;  // none: the scan is taken as instantaneous
+  // Why the cloud's own times (`field`) were not used, or not all used; empty when they were.
+  std::string warning;
+  size_t outside_sweep = 0;  // points whose time lies outside the sweep: the projection drops them
+};
+
+// `field` needs one finite time per point, most of them within the sweep (SweepTiming::withinSweep()),
+// and not all the same: a cloud without times, with as many as it has points, with its times mostly out
+// of the sweep (a wrong unit or clock) or all equal (a driver that leaves them 0) is taken as
+// instantaneous; a few points out of it (NaN, jumps) are dropped. Each case says so in `warning`.
+CloudTimes inspectTimes(const PointCloud& cloud, const Config& config);
+
+// The constant velocity, a twist per second, that moves the sensor by `increment` (T^{t-1}_t) in `dt`
+// seconds: what a sweep around the scan's reference instant is deskewed under. Zero when dt is not
+// positive.
+Vector6d sweepVelocity(const Eigen::Isometry3d& increment, double dt);
+
+}  // namespace elo

@@ -1,0 +1,55 @@
+#include "elo/deskew.hpp"
+
+#include <algorithm>
+
+#include "core/common/deskew.hpp"
+
+namespace elo {
+
+CloudTimes inspectTimes(const PointCloud& cloud, const Config& config) {
+  CloudTimes times;
+  times.source = config.deskew.time_source;
+  if (times.source != TimeSource::field) return times;
+  times.source = TimeSource::none;
+  if (cloud.time.empty()) {
+    times.warning = "no per-point times: taken as instantaneous";
+    return times;
+  }
+  if (cloud.time.size() != cloud.points.size()) {
+    times.warning = "not one per-point time per point: taken as instantaneous";
+    return times;
+  }
+  const SweepTiming timing = SweepTiming::fromConfig(config.sensor, TimeSource::field);
+  float earliest = 0.0f;
+  float latest = 0.0f;
+  bool first = true;
+  for (float time : cloud.time) {
+    if (!timing.withinSweep(time)) {
+      ++times.outside_sweep;
+      continue;
+    }
+    earliest = first ? time : std::min(earliest, time);
+    latest = first ? time : std::max(latest, time);
+    first = false;
+  }
+  if (2 * times.outside_sweep > cloud.time.size()) {
+    times.warning = "per-point times mostly outside the sweep (a wrong unit or clock?): taken as instantaneous";
+    times.outside_sweep = 0;
+    return times;
+  }
+  if (earliest == latest) {
+    times.warning = "per-point times all equal: taken as instantaneous";
+    times.outside_sweep = 0;
+    return times;
+  }
+  times.source = TimeSource::field;
+  if (times.outside_sweep > 0) times.warning = "points with a time outside the sweep (NaN, jumps) dropped";
+  return times;
+}
+
+Vector6d sweepVelocity(const Eigen::Isometry3d& increment, double dt) {
+  if (!(dt > 0.0)) return Vector6d::Zero();
+  return logSE3(increment) / dt;
+}
+
+}  // namespace elo

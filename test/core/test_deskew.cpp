@@ -1,0 +1,310 @@
+// Motion compensation (docs/deskew.md): the per-point SE(3) math, the azimuth times, the deskewed
+// projection of a sweep taken while moving, bad per-point times, and the odometry on such sweeps.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "analytic_scene.hpp"
+#include "core/common/deskew.hpp"
+#include "core/common/eigen_interop.hpp"
+#include "elo/deskew.hpp"
+#include "elo/odometry.hpp"
+
+namespace elo {
+namespace {
+
+// A car at 10 m/s turning at 0.5 rad/s, bouncing a little: a 1 m seam at the ends of a sweep.
+Vector6d drivingVelocity() {
+  Vector6d velocity;
+  velocity << 10.0, 0.3, 0.05, 0.02, -0.03, 0.5;
+  return velocity;
+}
+
+TEST(Deskew, PointMathIsTheSe3ExponentialInFloat) {
+  // Rotations from none to beyond the series' half radian, on points out to 100 m.
+  const double rates[] = {0.0, 1e-4, 0.5, 4.0, 12.0};
+  for (double rate : rates) {
+    Vector6d velocity;
+    velocity << 12.0, -3.0, 0.5, 0.3 * rate, -0.2 * rate, rate;
+    for (float time : {-0.1f, -0.05f, 0.013f, 0.1f}) {
+      const Eigen::Isometry3d exact = expSE3(static_cast<double>(time) * velocity);
+      for (const Eigen::Vector3d& p : {Eigen::Vector3d(100, 0, 0), Eigen::Vector3d(-3, 40, -1.7),
+                                      Eigen::Vector3d(0.5, -0.5, 8)}) {
+        const Float3 moved = deskewPoint(toSweepVelocity(velocity), time, toFloat3(p.cast<float>()));
+        const Eigen::Vector3d expected = exact * p;
+        // Float rounding: a few ulps of the 100 m point.
+        EXPECT_LT((Eigen::Vector3d(moved.x, moved.y, moved.z) - expected).norm(), 4e-5)
+            << "rate " << rate << ", time " << time;
+        const Float3 turned = deskewDirection(toSweepVelocity(velocity), time, {0.0f, 0.6f, 0.8f});
+        EXPECT_LT((Eigen::Vector3d(turned.x, turned.y, turned.z) - exact.linear() * Eigen::Vector3d(0, 0.6, 0.8)).norm(),
+                  1e-6);
+      }
+    }
+  }
+}
+
+TEST(Deskew, SweepVelocityInterpolatesTheIncrementOnSe3) {
+  const Eigen::Isometry3d increment = test::pose(1.0, 0.1, -0.02, 0.5, -0.3, 4.0);
+  const Vector6d velocity = sweepVelocity(increment, 0.1);
+  // At the full interval the constant twist is the increment; halfway it is the geodesic's midpoint.
+  EXPECT_TRUE(expSE3(0.1 * velocity).isApprox(increment, 1e-12));
+  const Eigen::Isometry3d half = expSE3(0.05 * velocity);
+  EXPECT_TRUE((half * half).isApprox(increment, 1e-12));
+  EXPECT_EQ(sweepVelocity(increment, 0.0), Vector6d::Zero());
+}
+
+TEST(Deskew, AzimuthTimesFollowKittisConvention) {
+  const SweepTiming kitti = SweepTiming::fromConfig(SensorConfig(), TimeSource::azimuth);
+  // 0.5 (1 - atan2(y, x) / pi) of a 0.1 s sweep, relative to mid-sweep (facing forward). fastAtan2 errs by
+  // 1e-5 rad: 2e-7 s.
+  constexpr float kTolerance = 3e-7f;
+  EXPECT_NEAR(kitti.azimuthTime({10, 0, 0}), 0.0f, kTolerance);
+  EXPECT_NEAR(kitti.azimuthTime({0, 10, 1}), -0.025f, kTolerance);  // left: a quarter in
+  EXPECT_NEAR(kitti.azimuthTime({0, -10, 1}), 0.025f, kTolerance);  // right: three quarters
+  EXPECT_NEAR(kitti.azimuthTime({-10, 1e-5f, 0}), -0.05f, kTolerance);  // just after the start, behind
+  EXPECT_NEAR(kitti.azimuthTime({-10, -1e-5f, 0}), 0.05f, kTolerance);  // just before the end
+  for (int i = 0; i < 100; ++i) {
+    const double azimuth = -M_PI + 2.0 * M_PI * (i + 0.37) / 100.0;
+    const Float3 p{static_cast<float>(20 * std::cos(azimuth)), static_cast<float>(20 * std::sin(azimuth)), -1.0f};
+    const double kiss_icp = 0.5 * (-std::atan2(p.y, p.x) / M_PI + 1.0);
+    EXPECT_NEAR(kitti.azimuthTime(p), (kiss_icp - 0.5) * 0.1, kTolerance) << azimuth;
+  }
+  // Counter-clockwise at 20 Hz from straight ahead: the left is a quarter in, the back mid-sweep.
+  SensorConfig sensor;
+  sensor.clockwise = false;
+  sensor.sweep_start_azimuth_deg = 0.0;
+  sensor.rotation_rate_hz = 20.0;
+  const SweepTiming other = SweepTiming::fromConfig(sensor, TimeSource::azimuth);
+  EXPECT_NEAR(other.azimuthTime({0, 10, 0}), -0.0125f, kTolerance);
+  EXPECT_NEAR(other.azimuthTime({-10, 0, 0}), 0.0f, kTolerance);
+}
+
+// The sweep of a moving sensor, deskewed, is what an instantaneous sensor at the reference pose sees:
+// each vertex lies on the scene where a ray from the reference pose through it meets the scene.
+class MovingSweep : public ::testing::TestWithParam<TimeSource> {
+ protected:
+  void SetUp() override {
+    config_.runtime.threads = 2;
+    config_.deskew.time_source = GetParam();
+    truth_ = test::sweepScene(scene_, config_.sensor, reference_, drivingVelocity());
+    truth_.cloud.ring.clear();
+    if (GetParam() == TimeSource::azimuth) truth_.cloud.time.clear();
+    backend_ = makeBackend(config_);
+  }
+
+  // The share of the pixels farther than 0.3 m from an edge whose vertex lies on the scene, within
+  // `tolerance`, along its ray from the reference pose. (An instantaneous sensor sees the other side of
+  // an edge, and behind a pole what the moving one saw around it: a few pixels.)
+  double shareOnTheScene(double tolerance) {
+    const ScanImage& scan = backend_->scan();
+    size_t checked = 0;
+    size_t on_scene = 0;
+    for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
+      if (!scan.image.occupied(pixel) || truth_.edge_distance[scan.point_index[pixel]] < 0.3) continue;
+      const Eigen::Vector3d vertex = scan.image.vertex[pixel].cast<double>();
+      const test::Hit hit = scene_.cast(reference_.translation(), reference_.linear() * vertex.normalized());
+      on_scene += std::abs(hit.range - vertex.norm()) < tolerance;
+      ++checked;
+    }
+    EXPECT_GT(checked, 50000u);
+    return static_cast<double>(on_scene) / checked;
+  }
+
+  Config config_;
+  const test::Scene scene_ = test::streetScene();
+  const Eigen::Isometry3d reference_ = test::pose(-5, 0.5, 0, 0, 0, 10);
+  test::ScanWithTruth truth_;
+  std::unique_ptr<Backend> backend_;
+};
+
+TEST_P(MovingSweep, DeskewedWithTheTrueMotionEqualsTheInstantaneousScan) {
+  backend_->projectScan(truth_.cloud, 0.0f, {GetParam(), drivingVelocity()});
+  // Float precision at up to 60 m (azimuth times: fastAtan2's 2e-7 s more, 2 um at 10 m/s).
+  EXPECT_GT(shareOnTheScene(2e-4), 0.99);
+  backend_->projectScan(truth_.cloud, 0.0f, {GetParam(), Vector6d::Zero()});
+  EXPECT_LT(shareOnTheScene(0.01), 0.5);  // as measured: bent by the motion
+}
+
+TEST_P(MovingSweep, DeskewingAgainInPlaceEqualsDeskewingInTheProjection) {
+  backend_->projectScan(truth_.cloud, 0.0f, {GetParam(), drivingVelocity()});
+  backend_->segmentGround();
+  backend_->estimateNormals();
+  const ScanImage direct = backend_->scan();
+
+  Vector6d prior = 0.7 * drivingVelocity();  // a prior 30% off
+  backend_->projectScan(truth_.cloud, 0.0f, {GetParam(), prior});
+  backend_->segmentGround();
+  backend_->estimateNormals();
+  backend_->deskewScan(drivingVelocity());
+  EXPECT_GT(shareOnTheScene(2e-4), 0.99);
+  const ScanImage& again = backend_->scan();
+  // The same cloud point, wherever each projection put it (the prior's deskew moved some to other pixels).
+  std::vector<int32_t> direct_pixel(truth_.cloud.size(), -1);
+  for (size_t pixel = 0; pixel < direct.image.pixelCount(); ++pixel) {
+    if (direct.image.occupied(pixel)) direct_pixel[direct.point_index[pixel]] = static_cast<int32_t>(pixel);
+  }
+  size_t compared = 0;
+  size_t normals_compared = 0;
+  for (size_t pixel = 0; pixel < again.image.pixelCount(); ++pixel) {
+    if (!again.image.occupied(pixel)) continue;
+    const int32_t point = again.point_index[pixel];
+    const int32_t other = direct_pixel[point];
+    if (other < 0) continue;
+    ++compared;
+    EXPECT_LT((again.image.vertex[pixel] - direct.image.vertex[other]).norm(), 1e-5f);
+    // The normal turned with its window agrees with the one estimated on the deskewed window.
+    if (again.image.hasNormal(pixel) && direct.image.hasNormal(other) && truth_.edge_distance[point] > 0.5) {
+      EXPECT_GT(std::abs(again.image.normal[pixel].dot(direct.image.normal[other])), std::cos(0.5 * M_PI / 180.0));
+      EXPECT_NEAR(again.image.normal[pixel].norm(), 1.0f, 1e-6f);
+      ++normals_compared;
+    }
+  }
+  EXPECT_GT(compared, 60000u);
+  EXPECT_GT(normals_compared, 20000u);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothTimeSources, MovingSweep, ::testing::Values(TimeSource::field, TimeSource::azimuth));
+
+// Bad per-point times: taken as instantaneous, or the bad points dropped, always with a counted warning.
+TEST(DeskewTimes, UnusableTimesAreReportedAndNeverUsed) {
+  Config config;
+  PointCloud cloud = test::sweepScene(test::streetScene(), config.sensor, Eigen::Isometry3d::Identity(),
+                                      drivingVelocity())
+                         .cloud;
+  EXPECT_EQ(inspectTimes(cloud, config).source, TimeSource::field);
+  EXPECT_TRUE(inspectTimes(cloud, config).warning.empty());
+
+  const auto check = [&](PointCloud bad, const std::string& warning) {
+    const CloudTimes times = inspectTimes(bad, config);
+    EXPECT_EQ(times.source, TimeSource::none) << warning;
+    EXPECT_NE(times.warning.find(warning), std::string::npos) << times.warning;
+  };
+  PointCloud no_times = cloud;
+  no_times.time.clear();
+  check(no_times, "no per-point times");
+  PointCloud short_times = cloud;
+  short_times.time.pop_back();
+  check(short_times, "not one per-point time per point");
+  PointCloud zeros = cloud;
+  std::fill(zeros.time.begin(), zeros.time.end(), 0.0f);
+  check(zeros, "all equal");
+  PointCloud milliseconds = cloud;  // a driver's unit mistaken: -50 .. 50 "seconds"
+  for (float& time : milliseconds.time) time *= 1000.0f;
+  check(milliseconds, "mostly outside the sweep");
+
+  config.deskew.time_source = TimeSource::azimuth;  // the cloud's times are not looked at
+  EXPECT_EQ(inspectTimes(zeros, config).source, TimeSource::azimuth);
+  EXPECT_TRUE(inspectTimes(zeros, config).warning.empty());
+}
+
+TEST(DeskewTimes, PointsWithATimeOutsideTheSweepAreDroppedAndCounted) {
+  Config config;
+  config.runtime.threads = 2;
+  const test::ScanWithTruth truth =
+      test::sweepScene(test::streetScene(), config.sensor, Eigen::Isometry3d::Identity(), drivingVelocity());
+  PointCloud bad = truth.cloud;
+  PointCloud without = truth.cloud;
+  without.points.clear();
+  without.time.clear();
+  without.ring.clear();
+  const float broken[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), 1e9f,
+                          -0.21f};
+  for (size_t i = 0; i < bad.size(); ++i) {
+    if (i % 97 == 0) {
+      bad.time[i] = broken[(i / 97) % 4];
+    } else {
+      without.points.push_back(bad.points[i]);
+      without.time.push_back(bad.time[i]);
+      without.ring.push_back(bad.ring[i]);
+    }
+  }
+  const CloudTimes times = inspectTimes(bad, config);
+  EXPECT_EQ(times.source, TimeSource::field);
+  EXPECT_EQ(times.outside_sweep, bad.size() - without.size());
+  EXPECT_NE(times.warning.find("dropped"), std::string::npos);
+  // The projection drops exactly those points: the same image as the cloud without them.
+  const auto project = [&](const PointCloud& cloud) {
+    std::unique_ptr<Backend> backend = makeBackend(config);
+    backend->projectScan(cloud, 0.0f, {TimeSource::field, drivingVelocity()});
+    return backend->scan().image;
+  };
+  const SphericalImage from_bad = project(bad);
+  const SphericalImage from_good = project(without);
+  EXPECT_EQ(from_bad.range, from_good.range);
+  EXPECT_EQ(from_bad.vertex, from_good.vertex);
+
+  Odometry odometry(config);
+  const FrameResult result = odometry.process(bad);
+  EXPECT_TRUE(result.processed);
+  EXPECT_EQ(result.points_without_time, times.outside_sweep);
+  EXPECT_EQ(odometry.timeWarningCounts().at(times.warning), 1u);
+}
+
+// A drive at 10 m/s, turning: deskewed (by either time source) the odometry tracks the truth as on
+// instantaneous scans; as measured it drifts. The second scan registers against the first as measured
+// (nothing is known of the motion before), exactly as without deskew.
+struct DriveError {
+  double second_scan_mm = 0.0;  // translation error of the second scan
+  double drift_mm = 0.0;        // the largest translation error after it, relative to it
+  double drift_deg = 0.0;
+};
+
+DriveError driveError(TimeSource source, RegistrationMode mode, bool moving_sweeps) {
+  Config config;
+  config.runtime.threads = 2;
+  config.deskew.time_source = source;
+  config.model.mode = mode;
+  Odometry odometry(config);
+  const test::Scene scene = test::streetScene();
+  const Eigen::Isometry3d start = test::pose(-25, 0, 0, 0, 0, 0);
+  const double period = 0.1;
+  Vector6d velocity;
+  velocity << 10.0, 0.0, 0.0, 0.0, 0.0, 0.12;
+  DriveError error;
+  Eigen::Isometry3d second_pose = Eigen::Isometry3d::Identity();
+  for (int frame = 0; frame < 10; ++frame) {
+    const Eigen::Isometry3d truth = expSE3(frame * period * velocity);
+    PointCloud cloud = moving_sweeps ? test::sweepScene(scene, config.sensor, start * truth, velocity, frame * period).cloud
+                                     : test::scanScene(scene, config.sensor, start * truth, frame * period).cloud;
+    cloud.ring.clear();
+    if (source == TimeSource::azimuth) cloud.time.clear();
+    const FrameResult result = odometry.process(cloud);
+    EXPECT_TRUE(result.processed) << result.skip_reason;
+    EXPECT_EQ(result.deskew_rounds, frame > 0 && source != TimeSource::none && moving_sweeps ? 1 : 0);
+    if (frame == 1) {
+      second_pose = result.pose;
+      error.second_scan_mm = (truth.inverse() * result.pose).translation().norm() * 1000.0;
+    } else if (frame > 1) {
+      const Eigen::Isometry3d truth_since = expSE3(period * velocity).inverse() * truth;
+      const Eigen::Isometry3d drift = truth_since.inverse() * second_pose.inverse() * result.pose;
+      error.drift_mm = std::max(error.drift_mm, drift.translation().norm() * 1000.0);
+      error.drift_deg = std::max(error.drift_deg, rotationAngle(drift) * 180.0 / M_PI);
+    }
+  }
+  return error;
+}
+
+class DeskewedDrive : public ::testing::TestWithParam<RegistrationMode> {};
+
+TEST_P(DeskewedDrive, TracksAsOnInstantaneousScans) {
+  const DriveError instantaneous = driveError(TimeSource::none, GetParam(), false);
+  const DriveError distorted = driveError(TimeSource::none, GetParam(), true);
+  std::printf("drift after the second scan (mm / deg): instantaneous %.1f / %.3f, distorted %.1f / %.3f\n",
+              instantaneous.drift_mm, instantaneous.drift_deg, distorted.drift_mm, distorted.drift_deg);
+  for (TimeSource source : {TimeSource::field, TimeSource::azimuth}) {
+    const DriveError deskewed = driveError(source, GetParam(), true);
+    std::printf("deskewed (%s): %.1f / %.3f; second scan %.2f mm, as measured %.2f mm\n",
+                source == TimeSource::field ? "field" : "azimuth", deskewed.drift_mm, deskewed.drift_deg,
+                deskewed.second_scan_mm, distorted.second_scan_mm);
+    EXPECT_EQ(deskewed.second_scan_mm, distorted.second_scan_mm);
+    EXPECT_LT(deskewed.drift_mm, std::max(2.0 * instantaneous.drift_mm, 3.0));
+    EXPECT_LT(deskewed.drift_deg, std::max(2.0 * instantaneous.drift_deg, 0.01));
+    EXPECT_LT(deskewed.drift_mm, 0.1 * distorted.drift_mm);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BothModes, DeskewedDrive,
+                         ::testing::Values(RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame));
+
+}  // namespace
+}  // namespace elo
