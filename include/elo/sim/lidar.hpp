@@ -22,9 +22,9 @@ enum class TimeConvention {
   // Each point carries its firing time in `time`, relative to the stamp, which is the sweep's start (a
   // ROS driver's per-point time field): times lie in [0, sweep duration). Reference: the stamp.
   field,
-  // No per-point times, as in a KITTI .bin: a point's time follows from its azimuth (KITTI's HDL-64E:
-  // clockwise seen from above, the sweep starting and ending straight behind). Reference: mid-sweep,
-  // when the sensor faces forward; the stamp lies there.
+  // No per-point times, as in a KITTI .bin: a point's time follows from its azimuth (KITTI's HDL-64E,
+  // the sensor config's default: clockwise seen from above, the sweep starting and ending straight
+  // behind). Reference: mid-sweep, when the sensor faces forward; the stamp lies there.
   azimuth,
 };
 
@@ -75,7 +75,8 @@ class Lidar {
   // std::invalid_argument for an unusable sensor.
   Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed = 0);
 
-  // One revolution starting at `start`, step 0 straight behind, turning clockwise seen from above.
+  // One revolution starting at `start`, step 0 at sensor.sweep_start_azimuth_deg, turning as
+  // sensor.clockwise says (by default: from straight behind, clockwise seen from above).
   // `sensor_pose_at(time)` gives the sensor in the world frame; points are in the sensor frame of their
   // firing, in firing order, with `ring` (0 = top beam). The cloud's stamp is the reference instant,
   // start + referenceOffset(); its `time` (offset from the stamp) is filled only for a sweep with
