@@ -17,6 +17,8 @@ struct CloudTimes {
   // Why the cloud's own times (`field`) were not used, or not all used; empty when they were.
   std::string warning;
   size_t outside_sweep = 0;  // points whose time lies outside the sweep: the projection drops them
+  // The largest |time| of a point the projection keeps (s): half a revolution for `azimuth`, 0 for none.
+  double farthest = 0.0;
 };
 
 // `field` needs one finite time per point, most of them within the sweep (SweepTiming::withinSweep()),
@@ -29,5 +31,11 @@ CloudTimes inspectTimes(const PointCloud& cloud, const Config& config);
 // seconds: what a sweep around the scan's reference instant is deskewed under. Zero when dt is not
 // positive.
 Vector6d sweepVelocity(const Eigen::Isometry3d& increment, double dt);
+
+// Whether deskewing a sweep whose points lie up to `farthest` seconds from the reference under velocity
+// `to` instead of `from` changes its registration: when it moves the sensor's pose at the sweep's ends
+// by more than a converged registration step (registration.converged_translation and _rotation). Below
+// that, registering again would stop at its first step.
+bool changesRegistration(const Vector6d& from, const Vector6d& to, double farthest, const RegistrationConfig& config);
 
 }  // namespace elo

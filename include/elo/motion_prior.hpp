@@ -22,6 +22,11 @@ class MotionModel {
   // would integrate an acceleration nobody saw (1 mm/scan^2 is 5 m after 10 s at 10 Hz).
   void holdVelocityAlong(const Matrix6d& projector);
   void reset() { history_ = 0; }
+  // The velocity (twist per second) of the increment recorded last; zero before any. What a sweep is
+  // deskewed under before it is registered: the constant-acceleration extrapolation doubles the noise of
+  // the registrations it extrapolates, and the deskew feeds that noise back into the next registration
+  // (on the real HDL-64E scans its registrations stopped converging).
+  Vector6d velocity() const { return prior_ == MotionPrior::none || history_ == 0 ? Vector6d::Zero() : latest_velocity_; }
   // Whether predictions come from the recorded motion of the configured prior (rather than identity or
   // a shorter history): a registration may then start from a tight robust kernel.
   bool informed() const { return prior_ == MotionPrior::none ? false : history_ >= requiredHistory(); }

@@ -18,7 +18,7 @@ namespace elo {
 struct StageTimes {
   double projection = 0.0;
   double feature_extraction = 0.0;  // ground segmentation + normals + BEV map
-  double registration = 0.0;  // every round's registration (deskew.rounds)
+  double registration = 0.0;  // deskew rounds within it excluded
   double deskew = 0.0;  // deskewing the scan again in place and rebuilding its ground map, over the rounds
   double model_update = 0.0;
   double total = 0.0;
@@ -85,10 +85,14 @@ class Odometry {
   void restartModel();
   // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
   void followTimeline(double stamp, FrameResult& result);
-  // Registers the projected scan from `guess`, then deskews it again with the registered motion and
-  // registers again, deskew.rounds times (docs/deskew.md); against a provisional model, deskews once
-  // and keeps the first registration.
-  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, FrameResult& result);
+  // Registers the projected scan from `guess`; each time the registration converges, deskews the scan
+  // again under the registered motion and lets the registration go on, up to deskew.rounds times and
+  // while that changes the deskew by more than a converged step over the sweep (`farthest` seconds
+  // either side of the reference; changesRegistration()). Against a provisional model the scan is
+  // deskewed once, for the model, and the registration ends (docs/deskew.md).
+  // `deskewed`: the velocity the projection deskewed the scan under.
+  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                         FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;

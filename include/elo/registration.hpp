@@ -1,6 +1,8 @@
 // Gauss-Newton point-to-plane ICP on SE(3) over the fused cost w*E_S + (1-w)*E_G (Sec. III-A).
 #pragma once
 
+#include <functional>
+
 #include "elo/backend.hpp"
 #include "elo/degeneracy.hpp"
 
@@ -52,10 +54,15 @@ class KernelSchedule {
   double scale_;
 };
 
+// Called when the registration has converged at `model_from_scan`: it may move the scan's points (deskew
+// them again under the motion just registered, docs/deskew.md) and return true, and the registration
+// then goes on from there until it converges again; false ends the registration.
+using ScanRefresh = std::function<bool(const Eigen::Isometry3d& model_from_scan)>;
+
 // `informed_guess`: the initial guess comes from a motion model with enough history to trust it. The
 // steps then solve only the directions the scan constrains (see degeneracy.hpp); along the others the
 // estimate keeps the initial guess. Without an informed guess every direction is solved.
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
-                                const RegistrationConfig& config);
+                                const RegistrationConfig& config, const ScanRefresh& refresh = {});
 
 }  // namespace elo

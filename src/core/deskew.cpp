@@ -1,6 +1,7 @@
 #include "elo/deskew.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/common/deskew.hpp"
 
@@ -9,6 +10,7 @@ namespace elo {
 CloudTimes inspectTimes(const PointCloud& cloud, const Config& config) {
   CloudTimes times;
   times.source = config.deskew.time_source;
+  if (times.source == TimeSource::azimuth) times.farthest = 0.5 / config.sensor.rotation_rate_hz;
   if (times.source != TimeSource::field) return times;
   times.source = TimeSource::none;
   if (cloud.time.empty()) {
@@ -43,8 +45,14 @@ CloudTimes inspectTimes(const PointCloud& cloud, const Config& config) {
     return times;
   }
   times.source = TimeSource::field;
+  times.farthest = std::max(std::abs(earliest), std::abs(latest));
   if (times.outside_sweep > 0) times.warning = "points with a time outside the sweep (NaN, jumps) dropped";
   return times;
+}
+
+bool changesRegistration(const Vector6d& from, const Vector6d& to, double farthest, const RegistrationConfig& config) {
+  const Vector6d change = (to - from) * farthest;
+  return change.head<3>().norm() > config.converged_translation || change.tail<3>().norm() > config.converged_rotation;
 }
 
 Vector6d sweepVelocity(const Eigen::Isometry3d& increment, double dt) {

@@ -60,26 +60,31 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
-void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, FrameResult& result) {
-  const bool informed = motion_.informed();
-  auto stage_start = Clock::now();
-  result.registration = registerScan(*backend_, guess, informed, config_.registration);
-  result.times.registration = millisecondsSince(stage_start);
-  if (result.time_source == TimeSource::none) return;
-  for (int round = 0; round < config_.deskew.rounds && !result.registration.failed; ++round) {
-    stage_start = Clock::now();
-    backend_->deskewScan(sweepVelocity(result.registration.model_from_scan, dt));
+void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                                 FrameResult& result) {
+  Vector6d deskewed_under = deskewed;
+  const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& registered) {
+    if (result.time_source == TimeSource::none) return false;
+    // The scan that replaces a provisional model is deskewed for it whatever deskew.rounds says.
+    const int rounds = model_provisional_ ? 1 : config_.deskew.rounds;
+    const Vector6d velocity = sweepVelocity(registered, dt);
+    if (result.deskew_rounds >= rounds || !changesRegistration(deskewed_under, velocity, farthest, config_.registration)) {
+      return false;
+    }
+    const auto deskew_start = Clock::now();
+    backend_->deskewScan(velocity);
     backend_->buildGroundMap();
     backend_->synchronize();
-    result.times.deskew += millisecondsSince(stage_start);
+    result.times.deskew += millisecondsSince(deskew_start);
+    deskewed_under = velocity;
     ++result.deskew_rounds;
     // Against a model of the first scan as measured, the scan as measured registers best (the two are
     // bent alike): deskewed, it only replaces that model.
-    if (model_provisional_) break;
-    stage_start = Clock::now();
-    result.registration = registerScan(*backend_, result.registration.model_from_scan, informed, config_.registration);
-    result.times.registration += millisecondsSince(stage_start);
-  }
+    return !model_provisional_;
+  };
+  const auto stage_start = Clock::now();
+  result.registration = registerScan(*backend_, guess, motion_.informed(), config_.registration, deskew_again);
+  result.times.registration = millisecondsSince(stage_start) - result.times.deskew;
 }
 
 FrameResult Odometry::process(const PointCloud& cloud) {
@@ -102,8 +107,9 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
-  // Deskewed under the prior's velocity: the first scans (no prior yet) as they were measured.
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweepVelocity(guess, dt)});
+  // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
+  const Vector6d sweep_velocity = started_ ? motion_.velocity() : Vector6d::Zero();
+  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity});
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
@@ -121,7 +127,7 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.times.feature_extraction = millisecondsSince(stage_start);
 
   if (started_) {
-    registerAndDeskew(guess, dt, result);
+    registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
     result.delta = result.registration.model_from_scan;
     pose_ = pose_ * result.delta;
     motion_.record(result.delta, dt);

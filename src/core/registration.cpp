@@ -107,7 +107,7 @@ std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const V
 }  // namespace
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
-                                const RegistrationConfig& config) {
+                                const RegistrationConfig& config, const ScanRefresh& refresh) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
   KernelSchedule kernel(config, informed_guess);
@@ -130,6 +130,7 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
     const bool small = step->head<3>().norm() < config.converged_translation &&
                        step->tail<3>().norm() < config.converged_rotation;
     if (kernel.advance(small)) {
+      if (refresh && refresh(result.model_from_scan)) continue;
       result.converged = true;
       break;
     }

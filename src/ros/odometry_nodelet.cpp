@@ -174,6 +174,9 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   // Every scan the core saw, a skipped one repeating the last pose: the lines match elo_run's.
   trajectory_stamps_.push_back(converted.cloud.stamp);
   trajectory_poses_.push_back(result.pose);
+  if (!result.time_warning.empty()) {
+    NODELET_WARN_THROTTLE(kWarningPeriod, "per-point times: %s (deskew.time_source)", result.time_warning.c_str());
+  }
   if (!result.processed) {
     lock.unlock();
     statistics_.scanSkipped(result.skip_reason);

@@ -51,8 +51,12 @@ SimulatedScan Simulation::scan(int frame) const {
   const Eigen::Isometry3d pose = trajectory_->poseAt(start);
   // Moving cars stand where they are at the sweep's start; they move a metre or two during it.
   const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
-  return lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
-                      mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
+  SimulatedScan scan = lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
+                                    mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
+  // An instantaneous scan has no firing times: the odometry (deskew.time_source field) would move its
+  // points by them.
+  if (spec_.lidar.deskewed) scan.cloud.time.clear();
+  return scan;
 }
 
 }  // namespace elo::sim

@@ -13,19 +13,27 @@
 
 namespace elo {
 
-// The sensor's velocity over a sweep: a twist per second in the frame of the reference instant.
+// The sensor's velocity over a sweep: a twist (v, w) per second in the frame of the reference instant,
+// with the products of the exponential that do not depend on time, formed once per scan (of()).
 struct SweepVelocity {
-  Float3 linear;   // m/s
-  Float3 angular;  // rad/s
+  Float3 linear;   // v, m/s
+  Float3 angular;  // w, rad/s
+  float angular_squared;  // |w|^2
+  Float3 turned_linear;   // w x v
+  Float3 twice_turned_linear;  // w x (w x v)
 
+  ELO_HOST_DEVICE static SweepVelocity of(const Float3& linear, const Float3& angular) {
+    const Float3 turned = cross(angular, linear);
+    return {linear, angular, squaredNorm(angular), turned, cross(angular, turned)};
+  }
   ELO_HOST_DEVICE bool isZero() const { return elo::isZero(linear) && elo::isZero(angular); }
 };
 
-// The coefficients of the SE(3) exponential of a twist whose rotation turns by `angle`:
-// R = I + a [phi]x + b [phi]x^2 and V = I + b [phi]x + c [phi]x^2. Below half a radian (a sweep at up to
-// 5 rad/s either side of the reference) the Taylor series to the 6th power is exact to float precision
-// (the first term left out is under 1.1e-8) and, being plain arithmetic, rounds the same on both
-// backends; above it the closed forms.
+// The coefficients of the SE(3) exponential of a twist whose rotation turns by theta:
+// R = I + a [phi]x + b [phi]x^2 and V = I + b [phi]x + c [phi]x^2, phi the rotation vector. Below half a
+// radian (a sweep at up to 5 rad/s either side of the reference) the Taylor series to theta^6 is exact
+// to float precision (the first term left out is under 1.1e-8) and, being plain arithmetic, rounds the
+// same on both backends; above it the closed forms.
 struct TwistCoefficients {
   float a;
   float b;
@@ -34,9 +42,9 @@ struct TwistCoefficients {
   ELO_HOST_DEVICE static TwistCoefficients ofSquaredAngle(float angle_squared) {
     const float s = angle_squared;
     if (s < 0.25f) {
-      return {1.0f - s / 6.0f * (1.0f - s / 20.0f * (1.0f - s / 42.0f)),
-              0.5f - s / 24.0f * (1.0f - s / 30.0f * (1.0f - s / 56.0f)),
-              1.0f / 6.0f - s / 120.0f * (1.0f - s / 42.0f * (1.0f - s / 72.0f))};
+      return {1.0f + s * (-1.0f / 6.0f + s * (1.0f / 120.0f + s * (-1.0f / 5040.0f))),
+              0.5f + s * (-1.0f / 24.0f + s * (1.0f / 720.0f + s * (-1.0f / 40320.0f))),
+              1.0f / 6.0f + s * (-1.0f / 120.0f + s * (1.0f / 5040.0f + s * (-1.0f / 362880.0f)))};
     }
     const float angle = std::sqrt(s);
     const float sine = std::sin(angle);
@@ -44,26 +52,34 @@ struct TwistCoefficients {
   }
 };
 
-// R p = p + a (phi x p) + b (phi x (phi x p)).
-ELO_HOST_DEVICE inline Float3 rotateByVector(const Float3& phi, const TwistCoefficients& k, const Float3& p) {
-  const Float3 once = cross(phi, p);
-  return p + once * k.a + cross(phi, once) * k.b;
+// The rotation of exp(time (v, w)) applied to `p`: p + a t (w x p) + b t^2 (w x (w x p)), phi = t w.
+ELO_HOST_DEVICE inline Float3 rotateAt(const SweepVelocity& velocity, float time, const TwistCoefficients& k,
+                                       const Float3& p) {
+  const Float3 once = cross(velocity.angular, p);
+  return p + once * (k.a * time) + cross(velocity.angular, once) * (k.b * time * time);
 }
 
-// The point `p`, measured `time` seconds after the reference instant, in the reference frame.
+// The translation of exp(time (v, w)): V t v = t v + b t^2 (w x v) + c t^3 (w x (w x v)).
+ELO_HOST_DEVICE inline Float3 translationAt(const SweepVelocity& velocity, float time, const TwistCoefficients& k) {
+  const float time_squared = time * time;
+  return velocity.linear * time + velocity.turned_linear * (k.b * time_squared) +
+         velocity.twice_turned_linear * (k.c * time_squared * time);
+}
+
+ELO_HOST_DEVICE inline TwistCoefficients coefficientsAt(const SweepVelocity& velocity, float time) {
+  return TwistCoefficients::ofSquaredAngle(velocity.angular_squared * time * time);
+}
+
+// The point `p`, measured `time` seconds after the reference instant, in the reference frame:
+// exp(time (v, w)) p.
 ELO_HOST_DEVICE inline Float3 deskewPoint(const SweepVelocity& velocity, float time, const Float3& p) {
-  const Float3 phi = velocity.angular * time;
-  const Float3 rho = velocity.linear * time;
-  const TwistCoefficients k = TwistCoefficients::ofSquaredAngle(squaredNorm(phi));
-  const Float3 rho_once = cross(phi, rho);
-  const Float3 translation = rho + rho_once * k.b + cross(phi, rho_once) * k.c;
-  return rotateByVector(phi, k, p) + translation;
+  const TwistCoefficients k = coefficientsAt(velocity, time);
+  return rotateAt(velocity, time, k, p) + translationAt(velocity, time, k);
 }
 
 // A direction (a normal) at `time`, turned as deskewPoint() turns points.
 ELO_HOST_DEVICE inline Float3 deskewDirection(const SweepVelocity& velocity, float time, const Float3& n) {
-  const Float3 phi = velocity.angular * time;
-  return rotateByVector(phi, TwistCoefficients::ofSquaredAngle(squaredNorm(phi)), n);
+  return rotateAt(velocity, time, coefficientsAt(velocity, time), n);
 }
 
 // Where each point's time comes from, and the sweep it belongs to.
@@ -133,9 +149,10 @@ struct SweepDeskew {
 ELO_HOST_DEVICE inline void redeskewPixel(const SweepVelocity& applied, const SweepVelocity& velocity,
                                           const Float3& measured, float time, Float3& vertex, float& range,
                                           Float3& normal) {
-  vertex = deskewPoint(velocity, time, measured);
+  const TwistCoefficients k = coefficientsAt(velocity, time);
+  vertex = rotateAt(velocity, time, k, measured) + translationAt(velocity, time, k);
   range = norm(vertex);
-  if (!isZero(normal)) normal = deskewDirection(velocity, time, deskewDirection(applied, -time, normal));
+  if (!isZero(normal)) normal = rotateAt(velocity, time, k, deskewDirection(applied, -time, normal));
 }
 
 }  // namespace elo

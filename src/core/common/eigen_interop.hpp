@@ -25,8 +25,8 @@ inline Rigid3f toRigid3f(const Eigen::Isometry3d& transform) {
 }
 
 inline SweepVelocity toSweepVelocity(const Vector6d& twist) {
-  return {{static_cast<float>(twist(0)), static_cast<float>(twist(1)), static_cast<float>(twist(2))},
-          {static_cast<float>(twist(3)), static_cast<float>(twist(4)), static_cast<float>(twist(5))}};
+  return SweepVelocity::of({static_cast<float>(twist(0)), static_cast<float>(twist(1)), static_cast<float>(twist(2))},
+                           {static_cast<float>(twist(3)), static_cast<float>(twist(4)), static_cast<float>(twist(5))});
 }
 
 // The deskew of `cloud`'s projection under `motion` (Backend::projectScan()): per-point times from the
@@ -35,7 +35,7 @@ inline SweepDeskew sweepDeskew(const SensorConfig& sensor, const PointCloud& clo
   const bool has_times = cloud.time.size() == cloud.points.size();
   const TimeSource source = motion.times == TimeSource::field && !has_times ? TimeSource::none : motion.times;
   return {SweepTiming::fromConfig(sensor, source), source == TimeSource::field ? cloud.time.data() : nullptr,
-          source == TimeSource::none ? SweepVelocity{} : toSweepVelocity(motion.velocity)};
+          toSweepVelocity(source == TimeSource::none ? Vector6d::Zero() : motion.velocity)};
 }
 
 }  // namespace elo
