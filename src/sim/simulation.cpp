@@ -51,12 +51,10 @@ SimulatedScan Simulation::scan(int frame) const {
   const Eigen::Isometry3d pose = trajectory_->poseAt(start);
   // Moving cars stand where they are at the sweep's start; they move a metre or two during it.
   const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
-  SimulatedScan scan = lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
-                                    mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
-  // An instantaneous scan has no firing times: the odometry (deskew.time_source field) would move its
-  // points by them.
-  if (spec_.lidar.deskewed) scan.cloud.time.clear();
-  return scan;
+  // An instantaneous sweep comes without per-point times (Lidar::sweep): the odometry
+  // (deskew.time_source field) would move its points by them.
+  return lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
+                      mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
 }
 
 }  // namespace elo::sim
