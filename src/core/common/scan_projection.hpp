@@ -17,6 +17,15 @@ struct ScanPoint {
   int pixel;
 };
 
+// The measured point, time and vertex of cloud point `index` (`raw`), as scanPointPixel() places it;
+// false when it has no usable time. The projection's winners take their vertex again by this, without
+// the pixel's arithmetic.
+ELO_HOST_DEVICE inline bool scanPointVertex(const ElevationCorrection& correction, const SweepDeskew& deskew, int index,
+                                            const Float3& raw, ScanPoint& point) {
+  point.measured = correction.apply(raw);
+  return deskew.apply(index, point.measured, point.time, point.vertex);
+}
+
 // The pixel of cloud point `index` (`raw`), whose vertex is the point after the elevation correction and
 // the deskew. `ring` (or kNoRing) is the driver's beam index: when known, the beam's row (`ring_rows`,
 // `ring_count` entries) is exact where the elevation of a noisy point is not. False for a point that is
@@ -25,8 +34,7 @@ ELO_HOST_DEVICE inline bool scanPointPixel(const SphericalProjection& projection
                                            const SweepDeskew& deskew, int index, const Float3& raw, int ring,
                                            const int* ring_rows, int ring_count, ScanPoint& point) {
   if (!isFinite(raw)) return false;
-  point.measured = correction.apply(raw);
-  if (!deskew.apply(index, point.measured, point.time, point.vertex)) return false;
+  if (!scanPointVertex(correction, deskew, index, raw, point)) return false;
   int row = 0;
   int col = 0;
   if (!projection.pixelOf(point.vertex, row, col)) return false;

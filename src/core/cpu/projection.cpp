@@ -35,7 +35,7 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
     }
     const uint32_t index = winners.winner(pixel);
     ScanPoint point;
-    place(index, point);  // the winner's placement again: the same arithmetic, the same result
+    scanPointVertex(correction, deskew, static_cast<int>(index), toFloat3(cloud.points[index]), point);
     image.vertex[pixel] = toVec3f(point.vertex);
     image.range[pixel] = norm(point.vertex);
     image.stamp[pixel] = stamp;

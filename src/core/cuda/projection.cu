@@ -46,7 +46,8 @@ __global__ void takeWinners(const ClosestKey* pixel_keys, PointPlacement placeme
     } else {
       const uint32_t index = closestWinsSource(key);
       ScanPoint point;
-      placement.place(static_cast<int>(index), point);  // the winner's placement again: the same result
+      scanPointVertex(placement.correction, placement.deskew, static_cast<int>(index), placement.cloud.points[index],
+                      point);
       scan.vertices[pixel] = point.vertex;
       scan.ranges[pixel] = norm(point.vertex);
       scan.stamps[pixel] = stamp;
