@@ -4,14 +4,18 @@
 # (Table III also with the normal gate opened, and with the simulator's clutter), and a drive through
 # KITTI 00's ground-truth poses when the shared data has them. Prints one table (KITTI metric t_rel and
 # r_rel, ATE, odometry FPS), then Table III on the real scans when the shared data has them: the gap
-# between runs forward and in reverse, which needs no ground truth.
+# between runs forward and in reverse, which needs no ground truth; then the deskew table (issue 15,
+# docs/deskew_accuracy.md): urban and highway drives with the HDL-64E and the VLP-16 as instantaneous
+# scans and as sweeps with motion in both time conventions, without and with deskew.
 # Usage:
-#   tools/accuracy.sh BUILD_DIR [SHARED_DATA_DIR]
+#   tools/accuracy.sh BUILD_DIR [SHARED_DATA_DIR] [deskew]
 # Works in BUILD_DIR/accuracy/ (scans are deleted after each run, trajectories kept); the table is
-# also written to BUILD_DIR/accuracy/table.txt. Takes about 40 minutes on 2 cores.
+# also written to BUILD_DIR/accuracy/table.txt. Takes about 40 minutes on 2 cores, plus about 30 for the
+# deskew table; `deskew` as the third argument makes only the deskew table.
 set -euo pipefail
 build=${1:-build}
 data=${2:-../shared/data}
+only=${3:-}
 bin="$build/devel/lib/elo_odometry"
 configs="$(dirname "$0")/../config"
 work="$build/accuracy"
@@ -21,8 +25,10 @@ done
 rm -rf "$work"
 mkdir -p "$work"
 table="$work/table.txt"
-printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m FPS |
-  tee "$table"
+: >"$table"
+[ "$only" = deskew ] ||
+  printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m \
+    FPS | tee "$table"
 
 # evaluate LABEL SENSOR MODE [--set KEY=VALUE]...: runs the odometry, configured for SENSOR, over the
 # sequence simulated for LABEL and SENSOR and adds a table row; --set variants are named in the row.
@@ -56,6 +62,47 @@ simulate_and_evaluate() {
   done
   rm -rf "$dir/sequence/velodyne"
 }
+
+# deskew_table: each world and sensor simulated three times from the same seed: instantaneous scans (no
+# per-point times), and the sweep with motion in each time convention of elo_sim --deskewed 0: field
+# (PCD scans with per-point times, ground truth at the sweep's start) and azimuth (KITTI .bin without
+# times, ground truth at mid-sweep). Each runs in both modes without deskew (time_source none) and, for
+# the distorted ones, with its convention's time source.
+deskew_table() {
+  printf '\n%-15s %-7s %-22s %-5s %9s %9s %15s %8s\n' 'deskew drive' sensor 'scans, time_source' mode \
+    length_m 't_rel_%' 'r_rel_deg/100m' ATE_m | tee -a "$table"
+  local cell world sensor frames scans source mode dir
+  # The ctest gates' drives (test/pipeline/test_deskew_accuracy.cpp), from rest: urban up to 10 m/s (166 m),
+  # highway up to 25 m/s (190 m). The VLP-16 loses the highway drive even on instantaneous scans.
+  for cell in urban:hdl64:200 highway:hdl64:160 urban:vlp16:200 highway:os1-64:160 urban:os1-64:200; do
+    IFS=: read -r world sensor frames <<<"$cell"
+    for scans in instantaneous field azimuth; do
+      dir="$work/deskew-$world-$sensor-$scans"
+      local sim_args=(--deskewed 1)
+      [ "$scans" = field ] && sim_args=(--deskewed 0 --time-convention field --format pcd)
+      [ "$scans" = azimuth ] && sim_args=(--deskewed 0 --time-convention azimuth)
+      "$bin/elo_sim" --sensor "$sensor" --seed 7 --world "$world" --trajectory curves --frames "$frames" \
+        --output "$dir/sequence" "${sim_args[@]}" >&2
+      for source in none $([ "$scans" = instantaneous ] || echo "$scans"); do
+        for mode in f2m f2f; do
+          "$bin/elo_run" --input "$dir/sequence" --output "$dir/$mode-$source.txt" --config "$configs/$sensor.yaml" \
+            --mode "$mode" --quiet --set "deskew.time_source=$source" >/dev/null
+          "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$mode-$source.txt" | tail -n 1 |
+            awk -v w="$world/curves" -v s="$sensor" -v k="$scans, $source" -v m="$mode" \
+              '{printf "%-15s %-7s %-22s %-5s %9.1f %9.3f %15.4f %8.3f\n", w, s, k, m, $3, $4, $5, $8}' |
+            tee -a "$table"
+        done
+      done
+      rm -rf "$dir/sequence/velodyne" "$dir"/sequence/*.pcd
+    done
+  done
+}
+
+if [ "$only" = deskew ]; then
+  deskew_table
+  echo "table: $table"
+  exit 0
+fi
 
 # Frames for about 1 km from rest at each world's cruise speed (urban 10, highway 25, country 18,
 # parking 5 m/s; 1.5 m/s^2 to get there).
@@ -116,4 +163,5 @@ if [ -d "$real_scans" ]; then
 else
   echo "accuracy: no real scans at $real_scans (shared data absent); their forward-backward Table III skipped" >&2
 fi
+deskew_table
 echo "table: $table"

@@ -36,9 +36,9 @@ std::string usage() {
          "               (--trajectory " + joined(elo::sim::trajectoryNames()) + " | --poses FILE)\n"
          "               --frames N --output DIR [--bag FILE] [options]\n"
          "\n"
-         "Simulates a spinning LiDAR in a seeded procedural world and writes a KITTI-layout sequence:\n"
-         "DIR/velodyne/%06d.bin, DIR/poses.txt (ground truth in the sensor frame, scan 0 = identity),\n"
-         "DIR/times.txt and DIR/calib.txt (KITTI 00's Tr).\n"
+         "Simulates a spinning LiDAR in a seeded procedural world and writes a sequence: the scans,\n"
+         "DIR/poses.txt (ground truth in the sensor frame at each scan's stamp, scan 0 = identity),\n"
+         "DIR/times.txt (the stamps) and DIR/calib.txt (KITTI 00's Tr).\n"
          "\n"
          "  --world NAME         kind of world: urban street canyon, highway, country road, parking lot,\n"
          "                       tunnel (2 km of featureless tube, 100 m after the start)\n"
@@ -48,17 +48,28 @@ std::string usage() {
          "                       LiDAR frame with KITTI 00's Tr; one pose per frame at 10 Hz)\n"
          "  --frames N           scans to simulate (with --poses: default all the poses)\n"
          "  --output DIR         where the sequence is written\n"
+         "  --format bin|pcd     bin: KITTI's layout, DIR/velodyne/%06d.bin (x y z intensity; default);\n"
+         "                       pcd: DIR/%06d.pcd (x y z intensity ring, and time as in the bag)\n"
          "  --bag FILE           also write the sequence as a ROS bag: sensor_msgs/PointCloud2 on /points\n"
-         "                       (x y z intensity ring time, frame velodyne), ground truth on\n"
-         "                       /ground_truth and /tf (as kitti_to_bag --poses-frame lidar)\n"
+         "                       (x y z intensity ring, and time with --time-convention field; frame\n"
+         "                       velodyne, stamped as the scans +1 s), ground truth on /ground_truth and /tf\n"
+         "                       (as kitti_to_bag --poses-frame lidar)\n"
          "  --sensor NAME        " + joined(elo::sim::sensorNames()) + " (default hdl64)\n"
          "  --seed S             seed of the world, the noise and the unit's calibration errors (default 1):\n"
          "                       same seed, same scans\n"
          "  --config FILE        YAML parameters applied over the sensor's (e.g. sensor.max_range)\n"
          "  --noise M            range noise standard deviation in metres (default: the sensor's, 0.02)\n"
          "  --dropout P          probability that a return is lost (default 0.01)\n"
-         "  --deskewed 0|1       1: each scan taken at one instant (default); 0: the sensor moves\n"
-         "                       during the sweep and each point's time is its firing offset\n"
+         "  --deskewed 0|1       1: each scan taken at one instant, its stamp, and no per-point times\n"
+         "                       (default); 0: the sensor moves during the sweep (0.1 s at 10 Hz), each\n"
+         "                       point measured from where the sensor is when it fires\n"
+         "  --time-convention field|azimuth\n"
+         "                       with --deskewed 0, how the scans tell each point's time (the head turns\n"
+         "                       clockwise seen from above, from straight behind, as KITTI's HDL-64E):\n"
+         "                       field (default): a per-point `time` in the bag and PCD scans, in s from\n"
+         "                       the stamp, which is the sweep's start; the ground truth is at the stamp.\n"
+         "                       azimuth: no per-point times (KITTI .bin); a point's time is its sweep\n"
+         "                       fraction 0.5 (1 - atan2(y, x) / pi); stamp and ground truth at mid-sweep\n"
          "  --moving-cars N      cars driving along the road (default 0)\n"
          "  --foliage-depth M    mean depth in metres that beams reach into leaves before echoing\n"
          "                       (default 0: solid crowns)\n"
@@ -78,6 +89,7 @@ using elo::tools::UsageError;
 struct Options {
   SimulationSpec spec;
   std::string output;
+  elo::sim::ScanFormat format = elo::sim::ScanFormat::kitti_bin;
   std::optional<std::string> bag;
   int threads = 0;
 };
@@ -92,7 +104,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
-      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads"};
+      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -123,6 +135,10 @@ Options parseOptions(int argc, char** argv) {
   if (!output) throw UsageError("--output is required");
   options.output = *output;
   options.bag = take("--bag");
+  if (const auto format = take("--format")) {
+    if (*format != "bin" && *format != "pcd") throw UsageError("--format expects bin or pcd");
+    options.format = *format == "bin" ? elo::sim::ScanFormat::kitti_bin : elo::sim::ScanFormat::pcd;
+  }
 
   const auto trajectory = take("--trajectory");
   const auto poses = take("--poses");
@@ -170,6 +186,13 @@ Options parseOptions(int argc, char** argv) {
     if (*deskewed != "0" && *deskewed != "1") throw UsageError("--deskewed expects 0 or 1");
     spec.lidar.deskewed = *deskewed == "1";
   }
+  if (const auto convention = take("--time-convention")) {
+    if (*convention != "field" && *convention != "azimuth") throw UsageError("--time-convention expects field or azimuth");
+    // An instantaneous scan has no times to tell: the option would silently do nothing.
+    if (spec.lidar.deskewed) throw UsageError("--time-convention needs --deskewed 0");
+    spec.lidar.time_convention =
+        *convention == "field" ? elo::sim::TimeConvention::field : elo::sim::TimeConvention::azimuth;
+  }
   if (const auto cars = take("--moving-cars")) spec.moving_cars = static_cast<int>(parseInteger("--moving-cars", *cars, 0));
   if (const auto depth = take("--foliage-depth")) {
     spec.lidar.foliage_depth = elo::tools::parseNumber<double>("--foliage-depth", *depth);
@@ -197,8 +220,8 @@ int run(const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   elo::sim::SequenceSummary summary;
-  // --bag: the scans go to the bag as they are simulated, with the ring and per-point time that the
-  // KITTI .bin files cannot hold.
+  // --bag: the scans go to the bag as they are simulated, with the ring and any per-point times that
+  // the KITTI .bin files cannot hold.
   std::optional<elo_ros::SequenceBagWriter> bag;
   if (options.bag) bag.emplace(*options.bag, elo_ros::SequenceBagOptions());
   const elo::sim::ScanSink to_bag = [&bag](const elo::sim::SimulatedScan& scan, const Eigen::Isometry3d& pose) {
@@ -206,7 +229,8 @@ int run(const Options& options) {
   };
   arena.execute([&] {
     const elo::sim::Simulation simulation(options.spec);
-    summary = elo::sim::writeSequence(simulation, options.output, bag ? to_bag : elo::sim::ScanSink());
+    summary = elo::sim::writeSequence(simulation, options.output, options.format,
+                                      bag ? to_bag : elo::sim::ScanSink());
   });
   if (bag) bag->close();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -47,10 +47,13 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t u
   }
   beams_ = drawBeams(sensor, options, unit_seed);
   if (beams_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");
-  // The head turns clockwise seen from above (as Velodyne and Ouster sensors do), starting behind
-  // the vehicle: azimuth pi - 2 pi k / N, so that time grows with the range image's column.
+  // The head turns as the sensor config says, by default clockwise seen from above (as Velodyne and
+  // Ouster sensors do) starting straight behind the vehicle: azimuth pi - 2 pi k / N, so that time grows
+  // with the range image's column.
+  const double start = sensor.sweep_start_azimuth_deg * M_PI / 180.0;
+  const double turn = sensor.clockwise ? -1.0 : 1.0;
   for (int step = 0; step < sensor.azimuth_steps; ++step) {
-    const double azimuth = M_PI - 2.0 * M_PI * step / sensor.azimuth_steps;
+    const double azimuth = start + turn * 2.0 * M_PI * step / sensor.azimuth_steps;
     azimuth_cos_.push_back(std::cos(azimuth));
     azimuth_sin_.push_back(std::sin(azimuth));
   }
@@ -90,15 +93,20 @@ Eigen::Vector3d Lidar::actualDirection(int beam, int step) const {
 }
 
 SimulatedScan Lidar::sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
-                           double stamp, uint64_t seed) const {
+                           double start, uint64_t seed) const {
   std::vector<Eigen::Isometry3d> poses;
   if (options_.deskewed) {
-    poses.assign(1, sensor_pose_at(stamp));
+    poses.assign(1, sensor_pose_at(start));
   } else {
     poses.reserve(azimuthSteps());
-    for (int step = 0; step < azimuthSteps(); ++step) poses.push_back(sensor_pose_at(stamp + firingTime(step)));
+    for (int step = 0; step < azimuthSteps(); ++step) poses.push_back(sensor_pose_at(start + firingTime(step)));
   }
-  return addNoise(castAll(scene, poses), stamp, seed);
+  return addNoise(castAll(scene, poses), start, seed);
+}
+
+double Lidar::referenceOffset() const {
+  const bool mid_sweep = !options_.deskewed && options_.time_convention == TimeConvention::azimuth;
+  return mid_sweep ? 0.5 * sweepDuration() : 0.0;
 }
 
 std::vector<Lidar::Return> Lidar::castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const {
@@ -161,12 +169,13 @@ double Lidar::clutteredRange(const Return& previous, const Return& result, const
   return range;
 }
 
-SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const {
+SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double start, uint64_t seed) const {
   // One random stream in firing order: the same seed gives the same sweep whatever the thread count.
   Rng rng(seed);
   const int beams = beamCount();
+  const bool with_times = !options_.deskewed && options_.time_convention == TimeConvention::field;
   SimulatedScan scan;
-  scan.cloud.stamp = stamp;
+  scan.cloud.stamp = start + referenceOffset();
   for (int step = 0; step < azimuthSteps(); ++step) {
     for (int beam = 0; beam < beams; ++beam) {
       const Return& result = returns[static_cast<size_t>(step) * beams + beam];
@@ -182,7 +191,7 @@ SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double stamp, 
       scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
       scan.cloud.intensity.push_back(result.intensity);
       scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
-      scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
+      if (with_times) scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
       scan.surface.push_back(result.kind);
     }
   }

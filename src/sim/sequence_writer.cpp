@@ -10,24 +10,35 @@
 
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/pcd.hpp"
 
 namespace elo::sim {
 namespace {
 
-std::string scanPath(const std::filesystem::path& velodyne, int frame) {
+std::filesystem::path scanDirectory(const std::filesystem::path& root, ScanFormat format) {
+  return format == ScanFormat::kitti_bin ? root / "velodyne" : root;
+}
+
+void writeScan(const std::filesystem::path& scans, ScanFormat format, int frame, const PointCloud& cloud) {
   char name[16];
-  std::snprintf(name, sizeof(name), "%06d.bin", frame);
-  return (velodyne / name).string();
+  std::snprintf(name, sizeof(name), format == ScanFormat::kitti_bin ? "%06d.bin" : "%06d.pcd", frame);
+  const std::string path = (scans / name).string();
+  if (format == ScanFormat::kitti_bin) {
+    writeKittiBin(path, cloud);
+  } else {
+    writePcd(path, cloud);
+  }
 }
 
 }  // namespace
 
-SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory, const ScanSink& sink) {
+SequenceSummary writeSequence(const Simulation& simulation, const std::string& directory, ScanFormat format,
+                              const ScanSink& sink) {
   const std::filesystem::path root(directory);
-  const std::filesystem::path velodyne = root / "velodyne";
+  const std::filesystem::path scans = scanDirectory(root, format);
   std::error_code error;
-  std::filesystem::create_directories(velodyne, error);
-  if (error) throw IoError("cannot create '" + velodyne.string() + "': " + error.message());
+  std::filesystem::create_directories(scans, error);
+  if (error) throw IoError("cannot create '" + scans.string() + "': " + error.message());
 
   const int frames = simulation.frameCount();
   const Eigen::Isometry3d first_inverse = simulation.sensorPose(0).inverse();
@@ -52,7 +63,7 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
           tbb::make_filter<int, Frame>(tbb::filter_mode::parallel,
                                        [&](int frame) {
                                          auto scan = std::make_shared<const SimulatedScan>(simulation.scan(frame));
-                                         writeKittiBin(scanPath(velodyne, frame), scan->cloud);
+                                         writeScan(scans, format, frame, scan->cloud);
                                          return Frame{frame, std::move(scan)};
                                        }) &
           tbb::make_filter<Frame, void>(tbb::filter_mode::serial_in_order, [&](const Frame& frame) {

@@ -40,21 +40,21 @@ Simulation::Simulation(const SimulationSpec& spec)
   trajectory_ = std::make_unique<SensorTrajectory>(route, world_->ground(), spec.config.ground.sensor_height);
 }
 
-double Simulation::stamp(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }
+double Simulation::sweepStart(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }
+
+double Simulation::stamp(int frame) const { return sweepStart(frame) + lidar_.referenceOffset(); }
 
 Eigen::Isometry3d Simulation::sensorPose(int frame) const { return trajectory_->poseAt(stamp(frame)); }
 
 SimulatedScan Simulation::scan(int frame) const {
-  const double start = stamp(frame);
+  const double start = sweepStart(frame);
   const Eigen::Isometry3d pose = trajectory_->poseAt(start);
   // Moving cars stand where they are at the sweep's start; they move a metre or two during it.
   const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
-  SimulatedScan scan = lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
-                                    mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
-  // An instantaneous scan has no firing times: the odometry (deskew.time_source field) would move its
-  // points by them.
-  if (spec_.lidar.deskewed) scan.cloud.time.clear();
-  return scan;
+  // An instantaneous sweep comes without per-point times (Lidar::sweep): the odometry
+  // (deskew.time_source field) would move its points by them.
+  return lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
+                      mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
 }
 
 }  // namespace elo::sim

@@ -2,16 +2,15 @@
 // than the figure measured when the gate was set must fail, and the paper's ablations keep their order.
 #include <gtest/gtest.h>
 
-#include <memory>
 #include <string>
 #include <vector>
 
-#include "elo/eval/evaluation.hpp"
-#include "elo/odometry.hpp"
-#include "elo/sim/simulation.hpp"
+#include "simulated_drive.hpp"
 
 namespace elo {
 namespace {
+
+using test::evaluateOnDrive;
 
 // 300 scans (about 270 m) of the urban world on the `curves` drive, HDL-64E.
 sim::SimulationSpec urbanCurves(uint64_t seed) {
@@ -21,29 +20,6 @@ sim::SimulationSpec urbanCurves(uint64_t seed) {
   spec.frames = 300;
   spec.seed = seed;
   return spec;
-}
-
-// Runs one odometry per config over the simulated drive, every scan through all of them, and evaluates
-// each trajectory against the truth.
-std::vector<TrajectoryEvaluation> evaluateOnDrive(const sim::SimulationSpec& spec, const std::vector<Config>& configs) {
-  const sim::Simulation simulation(spec);
-  std::vector<std::unique_ptr<Odometry>> runs;
-  for (const Config& config : configs) runs.push_back(std::make_unique<Odometry>(config));
-  std::vector<Eigen::Isometry3d> truth;
-  std::vector<std::vector<Eigen::Isometry3d>> estimates(configs.size());
-  const Eigen::Isometry3d start = simulation.sensorPose(0);
-  for (int frame = 0; frame < simulation.frameCount(); ++frame) {
-    const PointCloud cloud = simulation.scan(frame).cloud;
-    truth.push_back(start.inverse() * simulation.sensorPose(frame));
-    for (size_t i = 0; i < runs.size(); ++i) {
-      const FrameResult result = runs[i]->process(cloud);
-      EXPECT_TRUE(result.processed) << "run " << i << ", frame " << frame << ": " << result.skip_reason;
-      estimates[i].push_back(result.pose);
-    }
-  }
-  std::vector<TrajectoryEvaluation> evaluations;
-  for (const auto& estimate : estimates) evaluations.push_back(evaluateTrajectory("urban", truth, estimate));
-  return evaluations;
 }
 
 struct Gate {

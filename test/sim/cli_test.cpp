@@ -37,6 +37,10 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --sensor hdl32" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --dropout 1.5" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --deskewed yes" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --deskewed 0 --time-convention gps" + out), 2);
+  // An instantaneous scan has no times to tell.
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --time-convention azimuth" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --format ply" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-range-bias -0.01" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-elevation-error -1" + out), 2);
   EXPECT_EQ(runTool("--world urban --poses /nonexistent/poses.txt" + out), 2);
@@ -62,8 +66,11 @@ std::set<std::string> fieldNames(const sensor_msgs::PointCloud2& cloud) {
   return names;
 }
 
+std::set<std::string> fieldNamesWithTime() { return {"x", "y", "z", "intensity", "ring", "time"}; }
+
 // The bag holds the scans written to disk, at their times (+1 s, as kitti_to_bag), with every field a
-// driver publishes for a sweep with motion, and the ground truth of poses.txt.
+// driver publishes for a sweep with motion (the field convention is the default), and the ground truth
+// of poses.txt.
 TEST(EloSimCli, WritesABag) {
   const elo::test::TempDirectory directory;
   const std::string bag_path = directory.file("seq.bag");
@@ -81,7 +88,7 @@ TEST(EloSimCli, WritesABag) {
     EXPECT_EQ(cloud->header.frame_id, "velodyne");
     EXPECT_NEAR(cloud->header.stamp.toSec(), sequence.stamp(scan) + 1.0, 1e-6);
     EXPECT_EQ(size_t{cloud->width} * cloud->height, sequence.load(scan).size());
-    EXPECT_EQ(fieldNames(*cloud), (std::set<std::string>{"x", "y", "z", "intensity", "ring", "time"}));
+    EXPECT_EQ(fieldNames(*cloud), fieldNamesWithTime());
     ++scan;
   }
   EXPECT_EQ(scan, 3u);
@@ -98,6 +105,53 @@ TEST(EloSimCli, WritesABag) {
     ++pose;
   }
   EXPECT_EQ(pose, 3u);
+}
+
+// Which fields and stamps a bag's clouds get: times only for a sweep with motion in the field
+// convention; the azimuth convention stamps each scan at mid-sweep, with its ground truth.
+TEST(EloSimCli, BagTimesFollowTheTimeConvention) {
+  const elo::test::TempDirectory directory;
+  const std::set<std::string> without_time = {"x", "y", "z", "intensity", "ring"};
+  struct Case {
+    std::string options;
+    std::set<std::string> fields;
+    double reference_offset;  // of the stamps from the sweeps' starts
+  };
+  const std::vector<Case> cases = {{"", without_time, 0.0},
+                                   {"--deskewed 0 --time-convention field", fieldNamesWithTime(), 0.0},
+                                   {"--deskewed 0 --time-convention azimuth", without_time, 0.05}};
+  for (size_t c = 0; c < cases.size(); ++c) {
+    const std::string name = "case" + std::to_string(c);
+    ASSERT_EQ(runTool("--world urban --trajectory straight --frames 2 --sensor vlp16 " + cases[c].options +
+                      " --output " + directory.file(name) + " --bag " + directory.file(name + ".bag")),
+              0)
+        << cases[c].options;
+    rosbag::Bag bag(directory.file(name + ".bag"), rosbag::bagmode::Read);
+    size_t scan = 0;
+    for (const rosbag::MessageInstance& message : rosbag::View(bag, rosbag::TopicQuery("/points"))) {
+      const auto cloud = message.instantiate<sensor_msgs::PointCloud2>();
+      ASSERT_TRUE(cloud);
+      EXPECT_EQ(fieldNames(*cloud), cases[c].fields) << cases[c].options;
+      EXPECT_NEAR(cloud->header.stamp.toSec(), 1.0 + 0.1 * scan + cases[c].reference_offset, 1e-6) << cases[c].options;
+      ++scan;
+    }
+    EXPECT_EQ(scan, 2u);
+  }
+}
+
+// --format pcd: the flat layout, the scans with their ring and times.
+TEST(EloSimCli, WritesPcdScans) {
+  const elo::test::TempDirectory directory;
+  ASSERT_EQ(runTool("--world urban --trajectory straight --frames 2 --sensor vlp16 --deskewed 0 --format pcd "
+                    "--output " + directory.file("seq")),
+            0);
+  EXPECT_FALSE(std::filesystem::exists(directory.file("seq/velodyne")));
+  const elo::Sequence sequence(directory.file("seq"));
+  ASSERT_EQ(sequence.size(), 2u);
+  const elo::PointCloud cloud = sequence.load(1);
+  EXPECT_EQ(cloud.time.size(), cloud.size());
+  EXPECT_EQ(cloud.ring.size(), cloud.size());
+  EXPECT_EQ(sequence.groundTruth().size(), 2u);
 }
 
 }  // namespace

@@ -67,14 +67,14 @@ TEST(Lidar, WallRangesAreExact) {
   const std::vector<double> elevations = elevationsOf(sensor);
   ASSERT_GT(scan.cloud.size(), 1000u);
   for (size_t i = 0; i < scan.cloud.size(); ++i) {
-    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.points[i]));
     const double elevation = elevations[scan.cloud.ring[i]];
     EXPECT_NEAR(rangeOf(scan.cloud, i), distance / (std::cos(elevation) * std::cos(azimuth)), 2e-5);
     EXPECT_NEAR(scan.cloud.points[i].x(), distance, 1e-5);
   }
 }
 
-TEST(Lidar, RingTimeAndOrderSanity) {
+TEST(Lidar, RingAndOrderSanity) {
   const SensorConfig sensor = exactSensor();
   const Lidar lidar(sensor, exactOptions());
   const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
@@ -82,14 +82,38 @@ TEST(Lidar, RingTimeAndOrderSanity) {
   const SimulatedScan scan = lidar.sweep(scene, atOrigin, stamp, 1);
   EXPECT_EQ(scan.cloud.stamp, stamp);
   ASSERT_EQ(scan.cloud.ring.size(), scan.cloud.size());
-  ASSERT_EQ(scan.cloud.time.size(), scan.cloud.size());
   ASSERT_EQ(scan.cloud.intensity.size(), scan.cloud.size());
+  // Taken at one instant: per-point times would only make a deskew move its points.
+  EXPECT_TRUE(scan.cloud.time.empty());
   for (size_t i = 0; i < scan.cloud.size(); ++i) {
     EXPECT_LT(scan.cloud.ring[i], lidar.beamCount());
-    EXPECT_GE(scan.cloud.time[i], 0.0f);
-    EXPECT_LT(scan.cloud.time[i], lidar.sweepDuration());
     EXPECT_GE(scan.cloud.intensity[i], 0.0f);
     EXPECT_LE(scan.cloud.intensity[i], 1.0f);
+    // Each point lies exactly at a firing's azimuth, in firing order: clockwise from behind.
+    const Eigen::Vector3f& p = scan.cloud.points[i];
+    const int step = stepOf(lidar, p);
+    EXPECT_NEAR(std::remainder(std::atan2(p.y(), p.x()) - azimuthOf(lidar, step), 2.0 * M_PI), 0.0, 1e-5);
+    if (i > 0) {
+      EXPECT_GE(step, stepOf(lidar, scan.cloud.points[i - 1])) << "points not in firing order";
+    }
+  }
+}
+
+TEST(Lidar, FieldTimesGrowClockwiseFromBehindFromTheStamp) {
+  LidarOptions options = exactOptions();
+  options.deskewed = false;
+  options.time_convention = TimeConvention::field;
+  const Lidar lidar(exactSensor(), options);
+  const Scene scene(std::make_shared<FlatGround>(-kSensorHeight), {});
+  const double start = 123.4;
+  const SimulatedScan scan = lidar.sweep(scene, atOrigin, start, 1);
+  EXPECT_EQ(lidar.referenceOffset(), 0.0);
+  EXPECT_EQ(scan.cloud.stamp, start);
+  ASSERT_EQ(scan.cloud.time.size(), scan.cloud.size());
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    EXPECT_GE(scan.cloud.time[i], 0.0f);
+    EXPECT_LT(scan.cloud.time[i], lidar.sweepDuration());
     if (i > 0) {
       EXPECT_GE(scan.cloud.time[i], scan.cloud.time[i - 1]) << "points not in firing order";
     }
@@ -130,7 +154,7 @@ TEST(Lidar, RangeNoiseHasTheConfiguredSpread) {
     const std::vector<double> elevations = elevationsOf(sensor);
     double sum = 0.0, sum_squares = 0.0;
     for (size_t i = 0; i < scan.cloud.size(); ++i) {
-      const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+      const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.points[i]));
       const double exact = distance / (std::cos(elevations[scan.cloud.ring[i]]) * std::cos(azimuth));
       const double error = rangeOf(scan.cloud, i) - exact;
       sum += error;
@@ -163,7 +187,7 @@ TEST(Lidar, IntensityFallsWithIncidence) {
   float head_on = 0.0f, oblique = 1.0f;
   for (size_t i = 0; i < scan.cloud.size(); ++i) {
     if (scan.cloud.ring[i] != 2) continue;  // the horizontal beam
-    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.time[i]));
+    const double azimuth = azimuthOf(lidar, stepOf(lidar, scan.cloud.points[i]));
     if (std::abs(azimuth) < 1e-9) head_on = scan.cloud.intensity[i];
     if (std::abs(azimuth - M_PI / 3.0) < 1e-9) oblique = scan.cloud.intensity[i];
   }
@@ -192,6 +216,58 @@ TEST(Lidar, MotionDuringTheSweepMovesLaterFirings) {
   for (const Eigen::Vector3f& point : still.cloud.points) EXPECT_NEAR(point.x(), 20.0, 1e-5);
 }
 
+// KITTI's convention, as KISS-ICP's loader applies it: a point's time is the sweep fraction
+// 0.5 (1 - atan2(y, x) / pi) of its azimuth, and the scan's stamp is mid-sweep.
+TEST(Lidar, AzimuthConventionTimesFollowFromTheAzimuthAroundMidSweep) {
+  const auto moving = [](double time) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation().x() = 10.0 * time;  // 10 m/s toward the wall
+    return pose;
+  };
+  LidarOptions options = exactOptions();
+  options.deskewed = false;
+  options.time_convention = TimeConvention::azimuth;
+  const Lidar lidar(exactSensor(), options);
+  const double start = 0.5;  // 15 m before the wall
+  const SimulatedScan scan = lidar.sweep(wallScene(20.0), moving, start, 1);
+  EXPECT_EQ(lidar.referenceOffset(), 0.5 * lidar.sweepDuration());
+  EXPECT_DOUBLE_EQ(scan.cloud.stamp, start + 0.05);
+  EXPECT_TRUE(scan.cloud.time.empty()) << "a .bin-like scan has no per-point times";
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  double earliest = 1.0, latest = 0.0;
+  for (const Eigen::Vector3f& point : scan.cloud.points) {
+    const double fraction = 0.5 * (1.0 - std::atan2(point.y(), point.x()) / M_PI);
+    const double time = start + fraction * lidar.sweepDuration();
+    // Fired from where the sensor was at that time.
+    EXPECT_NEAR(point.x(), 20.0 - 10.0 * time, 1e-4);
+    earliest = std::min(earliest, fraction);
+    latest = std::max(latest, fraction);
+  }
+  // The wall ahead is seen in the sweep's middle half, symmetric about mid-sweep, when the sensor faces it.
+  EXPECT_GT(earliest, 0.25);
+  EXPECT_LT(latest, 0.75);
+  EXPECT_NEAR(earliest + latest, 1.0, 0.01);
+}
+
+// The sweep starts where the sensor config says and turns its way: here counter-clockwise from straight
+// ahead, so that a quarter sweep in, the head faces left.
+TEST(Lidar, SweepFollowsTheConfiguredStartAndDirection) {
+  SensorConfig sensor = exactSensor();
+  sensor.clockwise = false;
+  sensor.sweep_start_azimuth_deg = 0.0;
+  LidarOptions options = exactOptions();
+  options.deskewed = false;
+  const Lidar lidar(sensor, options);
+  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+  ASSERT_EQ(scan.cloud.time.size(), scan.cloud.size());
+  ASSERT_GT(scan.cloud.size(), 1000u);
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const double turned = 2.0 * M_PI * scan.cloud.time[i] / lidar.sweepDuration();
+    const Eigen::Vector3f& p = scan.cloud.points[i];
+    EXPECT_NEAR(std::remainder(std::atan2(p.y(), p.x()) - turned, 2.0 * M_PI), 0.0, 1e-5);
+  }
+}
+
 TEST(Lidar, WeakEchoesThinOutWithRange) {
   SensorConfig sensor = exactSensor();
   sensor.beam_elevations_deg = {-1.0, -20.0};  // the road at 99 m and at 4.8 m
@@ -216,7 +292,7 @@ TEST(Lidar, TheCarHidesTheRoadJustInFrontAndBehind) {
   const Lidar lidar(sensor, options);
   const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
   std::vector<bool> seen(lidar.azimuthSteps(), false);
-  for (const float time : scan.cloud.time) seen[stepOf(lidar, time)] = true;
+  for (const Eigen::Vector3f& point : scan.cloud.points) seen[stepOf(lidar, point)] = true;
   const auto seenAt = [&](double degrees) {
     return seen[static_cast<int>(std::lround((180.0 - degrees) / 360.0 * lidar.azimuthSteps())) % lidar.azimuthSteps()];
   };

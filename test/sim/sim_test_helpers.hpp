@@ -32,9 +32,16 @@ inline LidarOptions exactOptions() {
   return options;
 }
 
-// The firing step of a point, recovered from its time offset.
+// The firing step of a point of a sweep with times in the field convention, recovered from its time.
 inline int stepOf(const Lidar& lidar, float time) {
   return static_cast<int>(std::lround(time / lidar.sweepDuration() * lidar.azimuthSteps()));
+}
+
+// The firing step of a point, recovered from its azimuth: step 0 fires straight behind and the head
+// turns clockwise seen from above.
+inline int stepOf(const Lidar& lidar, const Eigen::Vector3f& point) {
+  const double turned = (M_PI - std::atan2(point.y(), point.x())) / (2.0 * M_PI);  // in [0, 1]
+  return static_cast<int>(std::lround(turned * lidar.azimuthSteps())) % lidar.azimuthSteps();
 }
 
 // Elevation (rad) of each beam as the simulator fires it.

@@ -1,5 +1,6 @@
 // Whole simulations: every world gives a plausible HDL-64E scan, every sensor fires its beams, the
-// same seed gives byte-identical files, and the written ground truth is the simulated motion.
+// same seed gives byte-identical files, the written ground truth is the simulated motion at each scan's
+// reference instant, and PCD scans keep their per-point times.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "../io/temp_directory.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/sequence.hpp"
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/sequence_writer.hpp"
 #include "elo/sim/simulation.hpp"
@@ -195,6 +197,52 @@ TEST(Sequence, GroundTruthIsTheSimulatedMotion) {
   const PointCloud first = readKittiBin(directory.file("seq/velodyne/000000.bin"));
   EXPECT_EQ(first.size(), simulation.scan(0).cloud.size());
   EXPECT_EQ(lineCount(directory.file("seq/poses.txt")), 30u);
+}
+
+// A sweep with motion in the azimuth convention (KITTI's .bin) is referred to mid-sweep: its stamp
+// (times.txt) and its ground truth lie half a sweep after the sweep's start.
+TEST(Sequence, AzimuthConventionRefersStampsAndGroundTruthToMidSweep) {
+  const elo::test::TempDirectory directory;
+  SimulationSpec spec = smallSpec(1);
+  spec.lidar.deskewed = false;
+  spec.lidar.time_convention = TimeConvention::azimuth;
+  const Simulation simulation(spec);
+  writeSequence(simulation, directory.file("seq"));
+  const std::vector<double> stamps = readTimes(directory.file("seq/times.txt"));
+  const std::vector<Eigen::Isometry3d> poses = readKittiPoses(directory.file("seq/poses.txt"));
+  ASSERT_EQ(stamps.size(), 12u);
+  ASSERT_EQ(poses.size(), 12u);
+  const SensorTrajectory& trajectory = simulation.trajectory();
+  for (int frame = 0; frame < 12; ++frame) {
+    EXPECT_NEAR(stamps[frame], 0.1 * frame + 0.05, 1e-9);
+    EXPECT_DOUBLE_EQ(simulation.scan(frame).cloud.stamp, simulation.sweepStart(frame) + 0.05);
+    const Eigen::Isometry3d mid_sweep = trajectory.poseAt(0.05).inverse() * trajectory.poseAt(0.1 * frame + 0.05);
+    EXPECT_TRUE(poses[frame].isApprox(mid_sweep, 1e-9)) << "frame " << frame;
+  }
+  // Not a standing car, for which every reference instant gives the same pose: 0.9 m in 1.1 s from rest.
+  EXPECT_GT(poses[11].translation().norm(), 0.5);
+}
+
+// PCD scans keep what a .bin cannot: the ring, and the field convention's per-point times.
+TEST(Sequence, PcdScansCarryTheFieldTimes) {
+  const elo::test::TempDirectory directory;
+  SimulationSpec spec = smallSpec(1);
+  spec.frames = 3;
+  spec.lidar.deskewed = false;
+  spec.lidar.time_convention = TimeConvention::field;
+  const Simulation simulation(spec);
+  writeSequence(simulation, directory.file("seq"), ScanFormat::pcd);
+  const Sequence sequence(directory.file("seq"));
+  ASSERT_EQ(sequence.size(), 3u);
+  ASSERT_TRUE(sequence.hasGroundTruth());
+  for (size_t frame = 0; frame < 3; ++frame) {
+    const PointCloud expected = simulation.scan(static_cast<int>(frame)).cloud;
+    const PointCloud read = sequence.load(frame);
+    ASSERT_EQ(read.size(), expected.size());
+    EXPECT_EQ(read.time, expected.time);
+    EXPECT_EQ(read.ring, expected.ring);
+    EXPECT_NEAR(read.stamp, simulation.stamp(static_cast<int>(frame)), 1e-9);
+  }
 }
 
 TEST(Traffic, MovingCarsAppearAndMove) {

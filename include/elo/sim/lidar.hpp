@@ -16,15 +16,29 @@
 
 namespace elo::sim {
 
+// How a sweep with motion (LidarOptions::deskewed false) tells when each point was fired, as recorded
+// data does. The scan's reference instant is where its stamp and its ground-truth pose lie.
+enum class TimeConvention {
+  // Each point carries its firing time in `time`, relative to the stamp, which is the sweep's start (a
+  // ROS driver's per-point time field): times lie in [0, sweep duration). Reference: the stamp.
+  field,
+  // No per-point times, as in a KITTI .bin: a point's time follows from its azimuth (KITTI's HDL-64E,
+  // the sensor config's default: clockwise seen from above, the sweep starting and ending straight
+  // behind). Reference: mid-sweep, when the sensor faces forward; the stamp lies there.
+  azimuth,
+};
+
 struct LidarOptions {
   double dropout_probability = 0.01;  // chance that any return is lost (dust, spray, ...)
   // A return's echo strength is reflectivity * cos(incidence) * (10 m / range)^2; it is detected with
   // probability 1 - exp(-strength / detection_threshold). The default thins the road beyond about
   // 50 m as on a real HDL-64E while walls stay visible to max range; 0 detects every echo.
   double detection_threshold = 1e-4;
-  // true: the whole sweep is taken at its start pose (no motion distortion); false: each firing from
-  // the pose at its own time, as a real spinning sensor does while the vehicle moves.
+  // true: the whole sweep is taken at its start pose (no motion distortion) and its points carry no
+  // times, which a deskew would only misuse; false: each firing from the pose at its own time, as a
+  // real spinning sensor does while the vehicle moves, with the times told by `time_convention`.
   bool deskewed = true;
+  TimeConvention time_convention = TimeConvention::field;
   // Clutter that makes neighbouring pixels of a real scan lie on different surfaces; both are off by
   // default. foliage_depth: the mean depth (m, exponential, at most three times the mean) that a beam
   // reaches into leaves before it echoes. mixed_pixel_probability: the chance that a return beside a
@@ -61,11 +75,18 @@ class Lidar {
   // std::invalid_argument for an unusable sensor.
   Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed = 0);
 
-  // One revolution starting at `stamp`. `sensor_pose_at(time)` gives the sensor in the world frame;
-  // points are in the sensor frame of their firing, in firing order, with `ring` (0 = top beam) and
-  // `time` (offset from `stamp`). `seed` draws this sweep's noise and dropouts.
+  // One revolution starting at `start`, step 0 at sensor.sweep_start_azimuth_deg, turning as
+  // sensor.clockwise says (by default: from straight behind, clockwise seen from above).
+  // `sensor_pose_at(time)` gives the sensor in the world frame; points are in the sensor frame of their
+  // firing, in firing order, with `ring` (0 = top beam). The cloud's stamp is the reference instant,
+  // start + referenceOffset(); its `time` (offset from the stamp) is filled only for a sweep with
+  // motion in the field convention. `seed` draws this sweep's noise and dropouts.
   SimulatedScan sweep(const RayCaster& scene, const std::function<Eigen::Isometry3d(double)>& sensor_pose_at,
-                      double stamp, uint64_t seed) const;
+                      double start, uint64_t seed) const;
+
+  // The reference instant's offset from the sweep's start: half a sweep for a sweep with motion in the
+  // azimuth convention, else 0.
+  double referenceOffset() const;
 
   int beamCount() const { return static_cast<int>(beams_.size()); }
   int azimuthSteps() const { return static_cast<int>(azimuth_cos_.size()); }
@@ -83,7 +104,7 @@ class Lidar {
   };
   double firingTime(int step) const { return step * sweepDuration() / azimuthSteps(); }
   std::vector<Return> castAll(const RayCaster& scene, const std::vector<Eigen::Isometry3d>& poses) const;
-  SimulatedScan addNoise(const std::vector<Return>& returns, double stamp, uint64_t seed) const;
+  SimulatedScan addNoise(const std::vector<Return>& returns, double start, uint64_t seed) const;
   // The range of `result` with the clutter of LidarOptions; `previous` and `next` are the firings of its
   // beam before and after it.
   double clutteredRange(const Return& previous, const Return& result, const Return& next, Rng& rng) const;

@@ -34,8 +34,11 @@ class Simulation {
   explicit Simulation(const SimulationSpec& spec);
 
   int frameCount() const { return spec_.frames; }
-  double stamp(int frame) const;  // start of the frame's sweep (s); frame 0 starts at 0
-  Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the sweep's start
+  double sweepStart(int frame) const;  // s; frame 0's sweep starts at 0
+  // The frame's reference instant (s): its scan's stamp, the sweep's start but for a sweep with motion
+  // in the azimuth convention, whose reference is mid-sweep (Lidar::referenceOffset).
+  double stamp(int frame) const;
+  Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the frame's reference instant
   SimulatedScan scan(int frame) const;
 
   const World& world() const { return *world_; }
