@@ -79,11 +79,12 @@ TEST(TunnelDegeneracy, HandlingKeepsTheForwardMotionThatTheTunnelCannotObserve) 
   EXPECT_GT(handled.scans_inside, 30u);
   EXPECT_EQ(handled.degenerate_inside, handled.scans_inside) << "every scan deep inside lacks its forward motion";
   EXPECT_EQ(unhandled.degenerate_inside, 0u) << "threshold 0 turns the handling off";
-  // Measured (2026-11-22): with the handling 0.038 % (0.11 m off at the end), without 20 % (179 m off:
-  // Gauss-Newton steps of metres along x, driven by noise, so that figure varies from build to build). A
-  // regression by half fails the first.
+  // Measured: with the handling 0.038 % (0.11 m off at the end; 0.027 % and 0.08 m since the ground test's
+  // rise tolerance), without 5.9-20 % (77-179 m off: Gauss-Newton steps of metres along x, driven by noise,
+  // so that figure varies from build to build and with any change to the features). A regression by half
+  // fails the first; the second only has to show the run away, at over 30 times the first's bound.
   EXPECT_LT(drift[0], 1.5 * 0.038);
-  EXPECT_GT(drift[1], 10.0) << "without the handling the tunnel is expected to run away";
+  EXPECT_GT(drift[1], 2.0) << "without the handling the tunnel is expected to run away";
 }
 
 }  // namespace
