@@ -70,14 +70,16 @@ TEST(SimulatedDistortedBag, NodeletDeskewsByTheCloudsTimes) {
   std::vector<Eigen::Isometry3d> nodelet;
   for (const nav_msgs::Odometry& message : odometry) nodelet.push_back(poseOf(message));
 
-  const std::vector<Eigen::Isometry3d> deskewed = runInProcess(configWith(elo::TimeSource::field), sequence, clouds.size());
+  const std::vector<Eigen::Isometry3d> deskewed =
+      runInProcess(configWith(elo::TimeSource::field), sequence, clouds.size());
   double largest_difference = 0.0;
   for (size_t i = 0; i < nodelet.size(); ++i) {
     largest_difference = std::max(largest_difference, poseDifference(nodelet[i], deskewed[i]));
   }
   EXPECT_LT(largest_difference, 1e-9) << "the nodelet's trajectory differs from elo::Odometry's with field times";
 
-  const std::vector<Eigen::Isometry3d> skewed = runInProcess(configWith(elo::TimeSource::none), sequence, clouds.size());
+  const std::vector<Eigen::Isometry3d> skewed =
+      runInProcess(configWith(elo::TimeSource::none), sequence, clouds.size());
   const double path = truth.back().translation().norm();
   std::cout << "over " << clouds.size() << " scans (" << path << " m from the start): deskewed "
             << largestPositionError(truth, nodelet) << " m, " << finalRotationErrorDeg(truth, nodelet)
