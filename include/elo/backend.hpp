@@ -33,10 +33,12 @@ struct NormalEquations {
 
 // How the projection deskews a scan (docs/deskew.md): where its points' times come from (deskew.time_source,
 // or `none` for a cloud without usable times: instantaneous) and the sensor's velocity over the sweep, a
-// twist per second (translation, rotation) in the scan's frame at its reference instant.
+// twist per second (translation, rotation) in the scan's frame at its reference instant, and that instant
+// in the cloud's per-point times (`field`: CloudTimes::reference, the middle of the sweep).
 struct SweepMotion {
   TimeSource times = TimeSource::none;
   Vector6d velocity = Vector6d::Zero();
+  double reference = 0.0;
 };
 
 // A device backend queues the work of a stage call and returns; a call whose result the host needs (the

@@ -17,7 +17,13 @@ struct CloudTimes {
   // Why the cloud's own times (`field`) were not used, or not all used; empty when they were.
   std::string warning;
   size_t outside_sweep = 0;  // points whose time lies outside the sweep: the projection drops them
-  // The largest |time| of a point the projection keeps (s): half a revolution for `azimuth`, 0 for none.
+  // The reference instant the scan is deskewed to and registered at, in the cloud's per-point times (s):
+  // the middle of the sweep, half-way between the earliest and the latest time the projection keeps
+  // (`field`). Azimuth times count from mid-sweep already (0). A reference at one end of the sweep would
+  // double the lever arm of any error in the velocity the scan is deskewed under and bend the scan all
+  // one way, biasing its pose; at mid-sweep the errors of the two halves cancel (docs/deskew.md).
+  double reference = 0.0;
+  // The largest |time - reference| of a point the projection keeps (s): half the sweep; 0 for none.
   double farthest = 0.0;
 };
 

@@ -58,7 +58,12 @@ class Odometry {
   // Forgets the model, the motion and the pose: the next scan starts a new trajectory at identity.
   void reset();
 
+  // The sensor's pose at the latest processed scan's stamp (FrameResult::pose).
   const Eigen::Isometry3d& pose() const { return pose_; }
+  // The sensor's pose at the latest processed scan's reference instant: the frame the model and the
+  // scan's deskewed points live in (Backend::model(), Backend::scan()). Mid-sweep for `field` times
+  // (CloudTimes::reference); pose() for the other time sources.
+  Eigen::Isometry3d modelPose() const { return pose_ * stamp_in_reference_.inverse(); }
   const Config& config() const { return config_; }
   Backend& backend() { return *backend_; }
   // Why the odometry runs on another backend than runtime.backend asked for (runtime.backend_fallback);
@@ -95,15 +100,21 @@ class Odometry {
   // while that changes the deskew by more than a converged step over the sweep (`farthest` seconds
   // either side of the reference; changesRegistration()). Against a provisional model the scan is
   // deskewed once, for the model, and the registration ends (docs/deskew.md).
-  // `deskewed`: the velocity the projection deskewed the scan under.
-  void registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
-                         FrameResult& result);
+  // `deskewed`: the velocity the projection deskewed the scan under; returns the one it ends deskewed
+  // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
+  Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
+                             FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;
   std::string backend_warning_;
   MotionModel motion_;
-  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();  // at the latest scan's stamp
+  // Scans are registered, and the model and motion prior kept, at each scan's reference instant (mid-sweep;
+  // CloudTimes::reference): the latest scan's stamp frame in its reference frame, and that reference's
+  // offset from the stamp (s). Identity and 0 unless the scan had `field` times.
+  Eigen::Isometry3d stamp_in_reference_ = Eigen::Isometry3d::Identity();
+  double last_reference_ = 0.0;
   bool started_ = false;
   // The model holds only the first scan of a start, which had per-point times but no motion to deskew
   // them with: the next registered scan, deskewed with its registered motion, replaces it instead of

@@ -45,7 +45,8 @@ CloudTimes inspectTimes(const PointCloud& cloud, const Config& config) {
     return times;
   }
   times.source = TimeSource::field;
-  times.farthest = std::max(std::abs(earliest), std::abs(latest));
+  times.reference = 0.5 * (static_cast<double>(earliest) + latest);
+  times.farthest = 0.5 * (static_cast<double>(latest) - earliest);
   if (times.outside_sweep > 0) times.warning = "points with a time outside the sweep (NaN, jumps) dropped";
   return times;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "elo/deskew.hpp"
+#include "elo/se3.hpp"
 
 namespace elo {
 
@@ -31,6 +32,7 @@ void Odometry::restartModel() {
 void Odometry::reset() {
   restartModel();
   pose_ = Eigen::Isometry3d::Identity();
+  stamp_in_reference_ = Eigen::Isometry3d::Identity();
 }
 
 void Odometry::followTimeline(double stamp, FrameResult& result) {
@@ -62,8 +64,8 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
-void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
-                                 FrameResult& result) {
+Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed,
+                                     double farthest, FrameResult& result) {
   Vector6d deskewed_under = deskewed;
   const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& registered) {
     if (result.time_source == TimeSource::none) return false;
@@ -87,6 +89,7 @@ void Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, cons
   const auto stage_start = Clock::now();
   result.registration = registerScan(*backend_, guess, motion_.informed(), config_.registration, deskew_again);
   result.times.registration = millisecondsSince(stage_start) - result.times.deskew;
+  return deskewed_under;
 }
 
 FrameResult Odometry::process(const PointCloud& cloud) {
@@ -106,13 +109,15 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   result.time_warning = times.warning;
   result.points_without_time = times.outside_sweep;
   if (!times.warning.empty()) ++time_warnings_[times.warning];
-  const double dt = started_ ? since_first - last_since_first_ : 0.0;
+  // The motion is estimated between the scans' reference instants: the stamps' interval, moved by how the
+  // references lie within their sweeps (0 but for `field` times).
+  const double dt = started_ ? since_first - last_since_first_ + (times.reference - last_reference_) : 0.0;
   const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
   const Vector6d sweep_velocity = started_ ? motion_.velocity() : Vector6d::Zero();
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity});
+  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity, times.reference});
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
@@ -129,11 +134,22 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   backend_->synchronize();  // a device backend's stages run on after the calls return
   result.times.feature_extraction = millisecondsSince(stage_start);
 
+  // The scan's frame at its reference instant, relative to the last scan's; and its stamp's frame in it.
+  Eigen::Isometry3d reference_delta = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d stamp_in_reference = Eigen::Isometry3d::Identity();
   if (started_) {
-    registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
-    result.delta = result.registration.model_from_scan;
+    const Vector6d deskewed_under = registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
+    reference_delta = result.registration.model_from_scan;
+    // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference`
+    // seconds before the reference instant) is exp(-reference * velocity) in the reference frame.
+    stamp_in_reference = expSE3(-times.reference * deskewed_under);
+    // The first scan of a start had no velocity to place its stamp in its sweep; registered against it
+    // as measured (bent alike), this scan measured the motion between like instants of the two sweeps.
+    if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
+    // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
+    result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
     pose_ = pose_ * result.delta;
-    motion_.record(result.delta, dt);
+    motion_.record(reference_delta, dt);
     const Degeneracy& degeneracy = result.registration.degeneracy;
     if (degeneracy.any()) {
       ++degenerate_;
@@ -144,13 +160,15 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   stage_start = Clock::now();
   if (model_provisional_) backend_->resetModel();
   model_provisional_ = !started_ && times.source != TimeSource::none;
-  backend_->updateModel(result.delta, relative_stamp);
+  backend_->updateModel(reference_delta, relative_stamp);
   backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);
 
   started_ = true;
   last_stamp_ = cloud.stamp;
   last_since_first_ = since_first;
+  last_reference_ = times.reference;
+  stamp_in_reference_ = stamp_in_reference;
   ++processed_;
   result.processed = true;
   result.pose = pose_;

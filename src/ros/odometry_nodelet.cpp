@@ -233,6 +233,8 @@ OdometryNodelet::ScanMessages OdometryNodelet::buildMessages(const elo::FrameRes
       model_nonground_publisher_.getNumSubscribers() > 0 || model_ground_publisher_.getNumSubscribers() > 0;
   if (settings_.model_publish_rate > 0.0 && models_wanted && stamp >= next_model_stamp_) {
     next_model_stamp_ = stamp + 1.0 / settings_.model_publish_rate;
+    // In the sensor frame at the scan's reference instant, as are the labelled scans below: mid-sweep for
+    // per-point times from the cloud, a fraction of the sweep's motion from the stamp (docs/deskew.md).
     const elo::Model& model = odometry_->backend().model();
     messages.model_nonground = nonGroundModelCloud(model.nonground, header);
     messages.model_ground = groundModelCloud(model.ground, header);
@@ -304,9 +306,10 @@ bool OdometryNodelet::onSaveMap(std_srvs::Trigger::Request&, std_srvs::Trigger::
     if (files.map_file.empty()) throw std::invalid_argument("~map_file is not set");
     std::lock_guard<std::mutex> lock(odometry_mutex_);
     if (!frames_ || !last_processed_stamp_) throw std::runtime_error("no scan processed yet: the model is empty");
-    // The model lives in the latest scan's frame; the file holds it in the odom frame.
+    // The model lives in the latest scan's frame at its reference instant (mid-sweep for per-point times
+    // from the cloud: Odometry::modelPose()); the file holds it in the odom frame.
     const elo::PointCloud map =
-        modelPoints(odometry_->backend().model(), frames_->sensorPose(odometry_->pose()));
+        modelPoints(odometry_->backend().model(), frames_->sensorPose(odometry_->modelPose()));
     elo::writePcd(files.map_file, map);
     response.message = "wrote " + std::to_string(map.size()) + " model points (" + settings_.odom_frame +
                        " frame) to " + files.map_file;

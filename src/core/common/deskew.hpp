@@ -92,11 +92,14 @@ struct SweepTiming {
   // revolutions, so that drivers stamping a sweep at its start, middle or end all fit, and so does a
   // sensor turning at half the configured rate.
   float max_offset;
+  // The instant the points are moved to, in the cloud's per-point times (field; s): the scan's mid-sweep
+  // (CloudTimes::reference). A point's time is taken relative to it.
+  float reference;
 
-  static SweepTiming fromConfig(const SensorConfig& sensor, TimeSource source) {
+  static SweepTiming fromConfig(const SensorConfig& sensor, TimeSource source, float reference = 0.0f) {
     const float period = static_cast<float>(1.0 / sensor.rotation_rate_hz);
     return {source, sensor.clockwise ? -1.0f : 1.0f, static_cast<float>(sensor.sweep_start_azimuth_deg * M_PI / 180.0),
-            period, 2.0f * period};
+            period, 2.0f * period, reference};
   }
 
   // A per-point time this sweep can have (false for NaN too).
@@ -111,12 +114,13 @@ struct SweepTiming {
   }
 
   // The time of cloud point `index` (`measured`, with `times` the cloud's per-point times, null when it
-  // has none). False when its own time is not one of this sweep: the point is dropped.
+  // has none), relative to the reference. False when its own time is not one of this sweep: the point is
+  // dropped.
   ELO_HOST_DEVICE bool pointTime(const float* times, int index, const Float3& measured, float& time) const {
     switch (source) {
       case TimeSource::field:
-        time = times[index];
-        return withinSweep(time);
+        time = times[index] - reference;
+        return withinSweep(times[index]);
       case TimeSource::azimuth:
         time = azimuthTime(measured);
         return true;

@@ -34,7 +34,8 @@ inline SweepVelocity toSweepVelocity(const Vector6d& twist) {
 inline SweepDeskew sweepDeskew(const SensorConfig& sensor, const PointCloud& cloud, const SweepMotion& motion) {
   const bool has_times = cloud.time.size() == cloud.points.size();
   const TimeSource source = motion.times == TimeSource::field && !has_times ? TimeSource::none : motion.times;
-  return {SweepTiming::fromConfig(sensor, source), source == TimeSource::field ? cloud.time.data() : nullptr,
+  return {SweepTiming::fromConfig(sensor, source, static_cast<float>(motion.reference)),
+          source == TimeSource::field ? cloud.time.data() : nullptr,
           toSweepVelocity(source == TimeSource::none ? Vector6d::Zero() : motion.velocity)};
 }
 
