@@ -5,7 +5,7 @@
 # KITTI 00's ground-truth poses when the shared data has them. Prints one table (KITTI metric t_rel and
 # r_rel, ATE, odometry FPS), then Table III on the real scans when the shared data has them: the gap
 # between runs forward and in reverse, which needs no ground truth; then the deskew table (issue 15,
-# docs/deskew_accuracy.md): urban and highway drives with the HDL-64E and the VLP-16 as instantaneous
+# docs/deskew_accuracy.md): urban and highway drives with the HDL-64E, VLP-16 and OS1-64 as instantaneous
 # scans and as sweeps with motion in both time conventions, without and with deskew.
 # Usage:
 #   tools/accuracy.sh BUILD_DIR [SHARED_DATA_DIR] [deskew]
