@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# The CUDA backend's check, in one table: the CPU/CUDA agreement tests, compute-sanitizer's memcheck and
+# racecheck over a few real scans (deskew on, so that every kernel runs), and the CPU-against-GPU bench,
+# frame-to-model, over simulated drives of three sensors and the real scans.
+#
+# On a GPU machine with a full build:   tools/gpu_check.sh build/devel/lib/elo_odometry [SCANS_DIR]
+# From a kit packed by gpu_kit.sh:      bash .gpukit/setup.sh && source .gpukit/env.sh && tools/gpu_check.sh
+# (the executables are then on PATH and the kit's scans are the default SCANS_DIR).
+#
+# GPU_CHECK_FRAMES (default 600) sets the length of each simulated drive. The exit status is 1 when a
+# check fails; the bench figures are printed, never judged.
+set -uo pipefail
+bin=${1:-$(dirname "$(command -v elo_run)")}
+scans=${2:-$(ls -d "$bin"/../scans 2>/dev/null || echo ../shared/data/real/hdl64_drive_a)}
+frames=${GPU_CHECK_FRAMES:-600}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export CUDA_MODULE_LOADING=EAGER  # module loading stays out of the first frame's time
+failures=0
+rows=()
+
+row() { rows+=("$(printf '%-44s %s' "$1" "$2")"); }
+fail() { failures=$((failures + 1)); row "$1" "FAIL: $2"; }
+
+# The agreement tests: every stage and whole drives, CPU against CUDA.
+check_agreement() {
+  local log=$work/agreement.log
+  "$bin/test_backend_agreement" --gtest_brief=1 >"$log" 2>&1
+  local status=$? passed skipped total
+  passed=$(sed -n 's/.*\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log")
+  skipped=$(sed -n 's/.*\[  SKIPPED \] \([0-9]*\) test.*/\1/p' "$log")
+  total=$(sed -n 's/.*\[==========\] \([0-9]*\) tests.*ran.*/\1/p' "$log")
+  if [ "$status" -ne 0 ] || [ "${skipped:-0}" -ne 0 ]; then
+    fail "agreement tests (test_backend_agreement)" "status $status, ${passed:-0} passed, ${skipped:-0} skipped; $(grep -m3 FAILED "$log" | tr '\n' ' ')"
+  else
+    row "agreement tests (test_backend_agreement)" "${passed}/${total} passed"
+  fi
+}
+
+# compute-sanitizer TOOL over the first few real scans through the CUDA backend, deskew by azimuth on.
+check_sanitizer() {
+  local tool=$1 summary=$2 log=$work/$1.log
+  if ! command -v compute-sanitizer >/dev/null; then fail "compute-sanitizer $tool" "not installed"; return; fi
+  compute-sanitizer --tool "$tool" --error-exitcode 3 "$bin/elo_run" --input "$scans" --output "$work/p.txt" \
+    --frames 5 --quiet --backend cuda --set deskew.time_source=azimuth >"$log" 2>&1
+  local status=$? found
+  found=$(grep -m1 "$summary" "$log" | sed 's/^========= //')
+  if [ "$status" -ne 0 ]; then fail "compute-sanitizer $tool, 5 real scans" "status $status; ${found:-no summary}"
+  else row "compute-sanitizer $tool, 5 real scans" "${found:-no summary printed}"; fi
+}
+
+# Points per scan of a sequence: its .bin scans hold 16 bytes a point.
+mean_points() {
+  local dir=$1/velodyne
+  [ -d "$dir" ] || { echo "-"; return; }
+  echo $(( $(du -cb "$dir"/*.bin | tail -1 | cut -f1) / 16 / $(ls "$dir" | wc -l) ))
+}
+
+# One bench row: elo_run on the CPU (all threads) and on CUDA over INPUT, frame-to-model.
+bench_row() {
+  local name=$1 input=$2 points=$3
+  shift 3
+  local cpu cuda cpu_fps cuda_fps bare_fps upload_ms
+  cpu=$("$bin/elo_run" --input "$input" --output "$work/p.txt" --quiet --mode f2m --backend cpu "$@" 2>&1)
+  cuda=$("$bin/elo_run" --input "$input" --output "$work/p.txt" --quiet --mode f2m --backend cuda "$@" 2>&1) ||
+    { fail "bench $name" "$(tail -1 <<<"$cuda")"; return; }
+  cpu_fps=$(sed -n 's/^FPS: \([0-9.]*\) (pipeline).*/\1/p' <<<"$cpu")
+  cuda_fps=$(sed -n 's/^FPS: \([0-9.]*\) (pipeline).*/\1/p' <<<"$cuda")
+  bare_fps=$(sed -n 's/^FPS without the upload: \([0-9.]*\)/\1/p' <<<"$cuda")
+  upload_ms=$(awk '/^scan upload to GPU/ {print $5}' <<<"$cuda")
+  bench+=("$(printf '%-34s %8s %9s %9s %10s %10s %9s' "$name" "$points" "$cpu_fps" "$cuda_fps" \
+    "$(awk -v f="$cuda_fps" 'BEGIN {printf "%.3f", 1000 / f}')" "${bare_fps:--}" "${upload_ms:--}")")
+  echo "--- $name, CUDA" >>"$work/bench.log"
+  echo "$cuda" >>"$work/bench.log"
+}
+
+simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
+  local sensor=$1 world=$2 trajectory=$3 dir=$4
+  shift 4
+  "$bin/elo_sim" --world "$world" --trajectory "$trajectory" --frames "$frames" --seed 7 --sensor "$sensor" \
+    --output "$dir" "$@" >/dev/null
+}
+
+gpu=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1)
+echo "GPU check: ${gpu:-no nvidia-smi}; $(nproc) CPU cores; nvcc $(nvcc --version 2>/dev/null | sed -n 's/.*release \([0-9.]*\).*/\1/p')"
+check_agreement
+check_sanitizer memcheck "ERROR SUMMARY"
+check_sanitizer racecheck "RACECHECK SUMMARY"
+check_sanitizer synccheck "ERROR SUMMARY"
+
+bench=()
+simulate hdl64 urban curves "$work/hdl64"
+simulate vlp16 urban curves "$work/vlp16"
+simulate os1-128 urban curves "$work/os1_128"
+simulate hdl64 urban curves "$work/hdl64_distorted" --deskewed 0 --time-convention azimuth
+hdl_points=$(mean_points "$work/hdl64")
+bench_row "HDL-64E, urban, $frames scans" "$work/hdl64" "$hdl_points"
+bench_row "HDL-64E distorted, deskew azimuth" "$work/hdl64_distorted" "$(mean_points "$work/hdl64_distorted")" \
+  --set deskew.time_source=azimuth
+bench_row "VLP-16, urban, $frames scans" "$work/vlp16" "$(mean_points "$work/vlp16")"
+bench_row "OS1-128, urban, $frames scans" "$work/os1_128" "$(mean_points "$work/os1_128")"
+[ -d "$scans" ] && bench_row "real HDL-64E, $(ls "$scans" | wc -l) scans" "$scans" "-"
+
+echo
+printf '%-44s %s\n' "check" "result"
+printf '%s\n' "${rows[@]}"
+echo
+printf '%-34s %8s %9s %9s %10s %10s %9s\n' "bench, f2m" "points" "CPU FPS" "CUDA FPS" "ms/scan" \
+  "w/o upload" "upload ms"
+printf '%s\n' "${bench[@]}"
+echo "(CPU: all $(nproc) threads. CUDA FPS and ms/scan include the scan's upload; 'w/o upload' is the FPS without it.)"
+[ -n "${GPU_CHECK_LOG:-}" ] && cp "$work"/*.log "$GPU_CHECK_LOG"/ 2>/dev/null
+exit $((failures > 0))
