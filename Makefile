@@ -3,7 +3,8 @@
 # speed figures; `make accuracy` the accuracy table on simulated sequences. `make test-sanitize` runs the
 # suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
 # `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
-# rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png.
+# rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png;
+# `make gpu-check` checks and measures the CUDA backend on a GPU machine.
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
 export PATH := /usr/bin:$(PATH)
@@ -20,7 +21,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz
 
-.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot clean
+.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -83,6 +84,11 @@ fuzz: deps
 
 bench: build
 	tools/bench.sh $(BUILD) $(SHARED_DATA)
+
+# On a GPU machine: the agreement tests, compute-sanitizer and the CPU-against-GPU bench in one table
+# (tools/gpu_check.sh; docs/cuda.md says how to run it from a build packed for a machine without ROS).
+gpu-check: build
+	tools/gpu_check.sh $(BUILD)/devel/lib/elo_odometry $(SHARED_DATA)/real/hdl64_drive_a
 
 # The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth, then
 # replayed from a bag through the ROS node. DEMO_FRAMES=60 makes it short; see tools/demo.sh.
