@@ -1,7 +1,7 @@
 # Entry points for a fresh Debian 12 machine. `make demo` installs what is missing, builds and runs the
-# odometry on a simulated drive; `make test` does the same and runs every test; `make bench` prints the
-# speed figures; `make accuracy` the accuracy table on simulated sequences. `make test-sanitize` runs the
-# suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
+# odometry on a simulated drive; `make test` does the same and runs every test but the long drives, which
+# `make test-long` runs; `make bench` prints the speed figures; `make accuracy` the accuracy table on
+# simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
 # `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
 # rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png;
 # `make gpu-check` checks and measures the CUDA backend on a GPU machine.
@@ -21,7 +21,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz
 
-.PHONY: deps build test test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
+.PHONY: deps build test test-long test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -40,8 +40,12 @@ build: deps
 	  $(if $(NVCC),-DCMAKE_CUDA_COMPILER=$(NVCC))
 	cmake --build $(BUILD) -j$(JOBS)
 
+# Every test but the long simulated drives (labelled long, test/CMakeLists.txt), which test-long runs.
 test: build
-	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+	cd $(BUILD) && ctest --output-on-failure -LE long -j$(JOBS)
+
+test-long: build
+	cd $(BUILD) && ctest --output-on-failure -L long -j$(JOBS)
 
 # Sanitizer builds sit beside the normal one and are Release builds, like it (CMakeLists.txt,
 # ELO_SANITIZE). A report fails the test that caused it; test/sanitizers/ holds the suppressions of what
@@ -57,12 +61,12 @@ TSAN_ENV := TSAN_OPTIONS=suppressions=$(SANITIZER_FILES)/tsan.supp:history_size=
 
 test-sanitize: test-asan test-tsan
 
-# Every test, the ROS ones included, but those labelled long (test/CMakeLists.txt): under ASan the
-# simulated-accuracy drive alone takes longer than CI can give it, and its code runs in shorter drives.
+# Every test, the ROS ones included, but those labelled long (test/CMakeLists.txt) and the short demo:
+# under ASan the long drives take longer than CI can give them, and their code runs in shorter drives.
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) $(SANITIZER_CMAKE) -DELO_SANITIZE=address,undefined
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
-	cd $(ASAN_BUILD) && $(ASAN_ENV) ctest --output-on-failure -LE long -j$(JOBS)
+	cd $(ASAN_BUILD) && $(ASAN_ENV) ctest --output-on-failure -LE 'long|demo' -j$(JOBS)
 
 # The core library's tests: the threaded CPU kernels (TBB) and everything that calls them.
 test-tsan: deps
