@@ -1,8 +1,8 @@
 # Entry points for a fresh Debian 12 machine. `make demo` installs what is missing, builds and runs the
 # odometry on a simulated drive; `make test` does the same and runs every test but the long drives, which
 # `make test-long` runs; `make bench` prints the speed figures; `make accuracy` the accuracy table on
-# simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer;
-# `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
+# simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer +
+# UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer; `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
 # rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png;
 # `make gpu-check` checks and measures the CUDA backend on a GPU machine.
 SHELL := /bin/bash
