@@ -2,9 +2,10 @@
 # odometry on a simulated drive; `make test` does the same and runs every test but the long drives, which
 # `make test-long` runs; `make bench` prints the speed figures; `make accuracy` the accuracy table on
 # simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer +
-# UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer; `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make
-# rviz-screenshot` replays a simulated drive into rviz on a virtual screen and saves docs/rviz.png;
-# `make gpu-check` checks and measures the CUDA backend on a GPU machine.
+# UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer; `make fuzz` runs every libFuzzer
+# target for FUZZ_SECONDS (needs clang, which it installs); `make rviz-screenshot` replays a simulated
+# drive into rviz on a virtual screen and saves docs/rviz.png; `make gpu-check` checks and measures the
+# CUDA backend on a GPU machine.
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
 export PATH := /usr/bin:$(PATH)
