@@ -19,6 +19,8 @@ constexpr unsigned kFullWarp = 0xffffffffu;
 constexpr int kNonground = 0;  // term indices, as kTerms counts them
 constexpr int kGround = 1;
 constexpr int kPartialsPerLane = kReductionBlocks / 32;
+constexpr int kTotalRows = kTerms * kPartialRows;
+constexpr int kRowsPerWarp = (kTotalRows + kWarps - 1) / kWarps;
 static_assert(kReductionBlocks % 32 == 0, "a warp adds a row of partials, every lane as many");
 static_assert(kPartialRows <= kThreads, "a block writes each of its partial's rows with one thread");
 
@@ -146,21 +148,33 @@ __device__ void writeTotal(int row, double total, DeviceTermSums& result) {
 
 // In the last block: the totals of every row of both terms. Warp w adds rows w, w + kWarps, ...; lane l
 // the partials of blocks l, l + 32, ... in that order, then the lanes in a fixed tree. The partials are
-// read from L2 (__ldcg), where the other blocks' writes are; a term not summed gets zeros.
+// read from L2 (__ldcg), where the other blocks wrote them, all of a warp's rows at once so that it waits
+// for L2 only once; a row past the last reads the last again and is dropped. A term not summed gets zeros.
 __device__ void writeTotals(const LinearizeInputs& in, const double* partials, DeviceTermSums* results) {
   const int lane = threadIdx.x % 32;
-#pragma unroll 4
-  for (int r = threadIdx.x / 32; r < kTerms * kPartialRows; r += kWarps) {
-    const int term = r / kPartialRows;
-    double total = 0.0;
-    if (summed(in, term)) {
-      const double* row = partials + r * kReductionBlocks;
-      double lane_total = 0.0;
+  const int warp = threadIdx.x / 32;
+  double loaded[kRowsPerWarp][kPartialsPerLane];
 #pragma unroll
-      for (int k = 0; k < kPartialsPerLane; ++k) lane_total += __ldcg(row + lane + 32 * k);
-      total = warpSum(lane_total);
-    }
-    if (lane == 0) writeTotal(r % kPartialRows, total, results[term]);
+  for (int k = 0; k < kRowsPerWarp; ++k) {
+    const double* row = partials + min(warp + k * kWarps, kTotalRows - 1) * kReductionBlocks;
+#pragma unroll
+    for (int b = 0; b < kPartialsPerLane; ++b) loaded[k][b] = __ldcg(row + lane + 32 * b);
+  }
+  double totals[kRowsPerWarp];  // complete in lane 0
+#pragma unroll
+  for (int k = 0; k < kRowsPerWarp; ++k) {
+    double lane_total = 0.0;
+#pragma unroll
+    for (int b = 0; b < kPartialsPerLane; ++b) lane_total += loaded[k][b];
+    totals[k] = warpSum(lane_total);
+  }
+  if (lane != 0) return;
+#pragma unroll
+  for (int k = 0; k < kRowsPerWarp; ++k) {
+    const int r = warp + k * kWarps;
+    if (r >= kTotalRows) break;
+    const int term = r / kPartialRows;
+    writeTotal(r % kPartialRows, summed(in, term) ? totals[k] : 0.0, results[term]);
   }
 }
 

@@ -123,7 +123,10 @@ void CudaBackend::clearDevice() {
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
+  // linearize()'s count of the blocks done at 0, and its partial sums initialised: its last block reads
+  // (and drops) the rows of a term not summed.
   clear(finished_blocks_, 1, 0, stream);
+  clear(partial_sums_, kTerms * kPartialRows * kReductionBlocks, 0, stream);
   for (int count = 0; count < kCounts; ++count) host_counts_[count] = 0;
   synchronize();
 }
