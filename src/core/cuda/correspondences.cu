@@ -130,7 +130,7 @@ __device__ bool lastBlockToFinish(unsigned* finished_blocks) {
   if (threadIdx.x == 0) {
     const unsigned blocks = gridDim.x * gridDim.y;
     last = atomicInc(finished_blocks, blocks - 1) == blocks - 1;
-    __threadfence();  // the partials read below are read after every block's increment
+    __threadfence();  // the partials the block reads next are read after every block's increment
   }
   __syncthreads();
   return last;
