@@ -98,8 +98,8 @@ void CudaBackend::allocate() {
   scan_scratch_.reserve(scan_scratch_bytes_);
   counts_.reserve(kCounts);
   host_counts_.reserve(kCounts);
-  partial_sums_.reserve(kTerms * kReductionBlocks);
-  term_sums_.reserve(kTerms);
+  partial_sums_.reserve(kTerms * kPartialRows * kReductionBlocks);
+  finished_blocks_.reserve(1);
   host_term_sums_.reserve(kTerms);
 }
 
@@ -123,6 +123,10 @@ void CudaBackend::clearDevice() {
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
+  // linearize()'s count of the blocks done at 0, and its partial sums initialised: its last block reads
+  // (and drops) the rows of a term not summed.
+  clear(finished_blocks_, 1, 0, stream);
+  clear(partial_sums_, kTerms * kPartialRows * kReductionBlocks, 0, stream);
   for (int count = 0; count < kCounts; ++count) host_counts_[count] = 0;
   synchronize();
 }
@@ -274,10 +278,8 @@ NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan,
   inputs.gates = gates_;
   inputs.motion = toRigid3f(model_from_scan);
   inputs.kernel_scale = kernel_scale;
-  cuda::linearize(inputs, partial_sums_.data(), term_sums_.data(), stream_.get());
-  check(cudaMemcpyAsync(host_term_sums_.data(), term_sums_.data(), kTerms * sizeof(DeviceTermSums),
-                        cudaMemcpyDeviceToHost, stream_.get()),
-        "copying the sums to the host");
+  // The launch writes the sums into host_term_sums_ itself: one synchronisation and no copy.
+  cuda::linearize(inputs, {partial_sums_.data(), finished_blocks_.data()}, host_term_sums_.data(), stream_.get());
   synchronize();
   NormalEquations sums;
   sums.nonground = toTermSums(host_term_sums_[0]);

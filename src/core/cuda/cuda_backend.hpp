@@ -134,8 +134,8 @@ class CudaBackend final : public Backend {
 
   DeviceArray<int> counts_;
   PinnedArray<int> host_counts_;
-  DeviceArray<DeviceTermSums> partial_sums_;
-  DeviceArray<DeviceTermSums> term_sums_;
+  DeviceArray<double> partial_sums_;       // linearize()'s scratch
+  DeviceArray<unsigned> finished_blocks_;  // 0 between launches
   PinnedArray<DeviceTermSums> host_term_sums_;
 
   // Host views, filled on demand.

@@ -97,18 +97,22 @@ void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, c
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
 // correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A), packed as
-// point_to_plane.hpp lays them out.
+// point_to_plane.hpp lays them out, in one launch.
 struct DeviceTermSums {
   double values[kTermValues];
   int candidates;
   int inliers;
 };
 constexpr int kTerms = 2;  // 0: non-ground (E_S), 1: ground (E_G)
-// Fixed, so that every GPU sums in the same order: results are reproducible run to run and across GPUs.
-constexpr int kReductionBlocks = 256;
+// Blocks per term. Fixed, so that every GPU sums in the same order: results are reproducible run to run
+// and across GPUs. Both terms' blocks (2 x 128 of kThreads, about 120 registers a thread: two blocks an
+// SM) make one wave on a GPU of 128 SMs or more (an H100 has 132); a smaller GPU runs more waves.
+constexpr int kReductionBlocks = 128;
+// Rows of a block's partial sums: the packed sums, then the candidate and inlier counts.
+constexpr int kPartialRows = kTermValues + 2;
 
 struct LinearizeInputs {
-  bool nonground;  // which terms to sum; a term left out sums to zero
+  bool nonground;  // which terms to sum, at least one; a term left out sums to zero
   bool ground;
   DeviceScan scan;
   const int* registration_pixels;
@@ -124,7 +128,16 @@ struct LinearizeInputs {
   Rigid3f motion;
   double kernel_scale;
 };
-// `partials`: kTerms * kReductionBlocks per-block sums; `results`: kTerms totals.
-void linearize(const LinearizeInputs& inputs, DeviceTermSums* partials, DeviceTermSums* results, cudaStream_t stream);
+// The scratch of linearize(): every block's partial sums, term by term and row by row
+// (kTerms * kPartialRows * kReductionBlocks), and the count of the blocks done, which must be 0 before
+// the first launch and is 0 again after each.
+struct LinearizeScratch {
+  double* partials;
+  unsigned* finished_blocks;
+};
+// `results`: the kTerms totals, written by the launch's last block. Pinned host memory (addressable by
+// the device under unified addressing), so that the host reads them once the stream has got there.
+void linearize(const LinearizeInputs& inputs, const LinearizeScratch& scratch, DeviceTermSums* results,
+               cudaStream_t stream);
 
 }  // namespace elo::cuda
