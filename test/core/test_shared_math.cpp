@@ -219,8 +219,9 @@ TEST(SharedNormalEstimator, TheGpusScalarEstimatorGivesTheCpuBackendsNormalsBitF
 // Each pixel's normal from its block's tile (normal_tile.hpp), as the CUDA backend's blocks of
 // `block_rows` x `block_cols` pixels read it, against pixelNormal() over the whole scan.
 struct TileComparison {
-  size_t normals = 0;    // pixels with a normal over the whole scan
-  size_t differing = 0;  // pixels whose normal from the tile differs in any bit
+  size_t normals = 0;     // pixels with a normal over the whole scan
+  size_t differing = 0;   // pixels whose normal from the tile differs in any bit
+  size_t misplaced = 0;   // slots whose pixel the tile looks up elsewhere, in a slot holding another pixel
 };
 
 TileComparison compareTilesWithWholeScan(const Config& config, int block_rows, int block_cols) {
@@ -237,7 +238,13 @@ TileComparison compareTilesWithWholeScan(const Config& config, int block_rows, i
     for (int block_col = 0; block_col < pixels.cols; block_col += block_cols) {
       const cuda::TileShape shape = cuda::TileShape::around(params, block_row, block_col, block_rows, block_cols);
       std::vector<cuda::TilePixel> tile(shape.slots());
-      for (int slot = 0; slot < shape.slots(); ++slot) tile[slot] = cuda::loadTilePixel(pixels, shape, slot);
+      for (int slot = 0; slot < shape.slots(); ++slot) {
+        tile[slot] = cuda::loadTilePixel(pixels, shape, slot);
+        const int pixel = shape.pixelOfSlot(slot);
+        if (pixel < 0) continue;
+        const int found = shape.slotOfPixel(pixel);
+        comparison.misplaced += found < 0 || found >= shape.slots() || shape.pixelOfSlot(found) != pixel;
+      }
       const cuda::TileImage image{pixels.rows, pixels.cols, shape, tile.data(), scan.image.range.data()};
       for (int row = block_row; row < std::min(block_row + block_rows, pixels.rows); ++row) {
         for (int col = block_col; col < std::min(block_col + block_cols, pixels.cols); ++col) {
@@ -269,6 +276,7 @@ TEST(NormalTile, NormalsFromTheTilesAreThoseFromTheWholeScanBitForBit) {
         const TileComparison comparison = compareTilesWithWholeScan(config, block_rows, block_cols);
         EXPECT_GT(comparison.normals, width == 2048 ? 10000u : 10u);
         EXPECT_EQ(comparison.differing, 0u);
+        EXPECT_EQ(comparison.misplaced, 0u);
       }
     }
   }
