@@ -77,6 +77,7 @@ void CudaBackend::allocate() {
   pixel_times_.reserve(pixels_);
   pixel_keys_.reserve(pixels_);
   closest_keys_.reserve(pixels_);
+  pixel_surface_keys_.reserve(pixels_);
   registration_flags_.reserve(pixels_);
   registration_offsets_.reserve(pixels_);
   registration_pixels_.reserve(pixels_);
@@ -93,8 +94,8 @@ void CudaBackend::allocate() {
   first_sources_.reserve(cells_);
   source_cells_.reserve(sources);
   first_flags_.reserve(sources);
-  source_offsets_.reserve(sources);
-  scan_scratch_bytes_ = exclusiveSumScratchBytes(static_cast<int>(sources));
+  tile_firsts_.reserve(compactionTiles(sources));
+  scan_scratch_bytes_ = exclusiveSumScratchBytes(static_cast<int>(pixels_));  // the registration pixels
   scan_scratch_.reserve(scan_scratch_bytes_);
   counts_.reserve(kCounts);
   host_counts_.reserve(kCounts);
@@ -119,6 +120,8 @@ void CudaBackend::clearDevice() {
   for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1]}) {
     clear(map->point_of_cell, cells_, 0xff, stream);
   }
+  clear(closest_keys_, pixels_, 0xff, stream);
+  clear(pixel_surface_keys_, pixels_, 0xff, stream);
   clear(cell_keys_, cells_, 0xff, stream);
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
@@ -131,20 +134,12 @@ void CudaBackend::clearDevice() {
   synchronize();
 }
 
-void CudaBackend::synchronize() {
-  check(cudaStreamSynchronize(stream_.get()), "running the CUDA stages");
-  model_points_fetched_ = true;
-}
+void CudaBackend::synchronize() { check(cudaStreamSynchronize(stream_.get()), "running the CUDA stages"); }
 
 void CudaBackend::fetchCount(int count) {
   check(cudaMemcpyAsync(&host_counts_[count], counts_.data() + count, sizeof(int), cudaMemcpyDeviceToHost,
                         stream_.get()),
         "copying a count to the host");
-}
-
-int CudaBackend::modelPoints() {
-  if (!model_points_fetched_) synchronize();
-  return host_counts_[kModelPoints + current_];
 }
 
 DeviceScan CudaBackend::deviceScan() const {
@@ -165,8 +160,8 @@ DeviceBev CudaBackend::deviceBev(const BevBuffers& buffers, int count) const {
 }
 
 CellCompaction CudaBackend::compaction() const {
-  return {cell_keys_.data(),      surface_keys_.data(), first_sources_.data(), source_cells_.data(),  first_flags_.data(),
-          source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
+  return {cell_keys_.data(),    surface_keys_.data(), first_sources_.data(),
+          source_cells_.data(), first_flags_.data(),  tile_firsts_.data()};
 }
 
 // Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
@@ -297,26 +292,22 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
     const int next = 1 - current_;
     cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model, fusion,
-                             closest_keys_.data(), pixel_keys_.data(), deviceModel(next), stream);
-    cuda::fuseGroundModel(modelGroundMap(current_), modelPoints(), scanGroundMap(), static_cast<int>(pixels_), bev_,
-                          scan_from_model, fusion, modelGroundMap(next), compaction(), stream);
+                             closest_keys_.data(), pixel_surface_keys_.data(), deviceModel(next), stream);
+    cuda::fuseGroundModel(modelGroundMap(current_), scanGroundMap(), bev_, scan_from_model, fusion,
+                          modelGroundMap(next), compaction(), stream);
     current_ = next;
   }
   model_initialized_ = true;
   cuda::fitGroundNormals(modelGroundMap(current_), bev_, config_.bev.normal_neighbours,
                          config_.bev.normal_patch_radius, model_ground_normals_.data(), stream);
-  fetchCount(kModelPoints + current_);
-  model_points_fetched_ = false;
   model_view_current_ = false;
 }
 
 void CudaBackend::resetModel() {
-  synchronize();  // no copy into host_counts_ may be under way while it is written below
   const cudaStream_t stream = stream_.get();
   clear(model_image_[current_].ranges, pixels_, 0, stream);
   clear(model_image_[current_].normals, pixels_, 0, stream);
   cuda::clearGroundMap(modelGroundMap(current_), stream);
-  host_counts_[kModelPoints + current_] = 0;
   model_initialized_ = false;
   model_view_current_ = false;
 }
@@ -374,7 +365,9 @@ const Model& CudaBackend::model() {
   copyToHost(model_view_.nonground.normal, image.normals.data(), pixels_, stream);
   copyToHost(model_view_.nonground.range, image.ranges.data(), pixels_, stream);
   copyToHost(model_view_.nonground.stamp, image.stamps.data(), pixels_, stream);
-  copyBevView(model_ground_[current_], modelPoints(), model_view_.ground);
+  fetchCount(kModelPoints + current_);
+  synchronize();  // the count, before the points are copied
+  copyBevView(model_ground_[current_], host_counts_[kModelPoints + current_], model_view_.ground);
   model_view_.initialized = model_initialized_;
   model_view_current_ = true;
   return model_view_;

@@ -68,8 +68,6 @@ class CudaBackend final : public Backend {
   CellCompaction compaction() const;
   // Copies count `count` into host_counts_ once the stream gets there.
   void fetchCount(int count);
-  // The current model's point count, waiting for the stream when its copy may still be under way.
-  int modelPoints();
   void copyBevView(const BevBuffers& buffers, int points, BevImage& view);
 
   Config config_;
@@ -108,7 +106,8 @@ class CudaBackend final : public Backend {
   TimeSource scan_times_ = TimeSource::none;
   SweepVelocity scan_velocity_{};
   DeviceArray<ClosestKey> pixel_keys_;
-  DeviceArray<ClosestKey> closest_keys_;  // the model update's first round
+  DeviceArray<ClosestKey> closest_keys_;        // the model update's first round
+  DeviceArray<ClosestKey> pixel_surface_keys_;  // ... and its second
   DeviceArray<int> registration_flags_;
   DeviceArray<int> registration_offsets_;
   DeviceArray<int> registration_pixels_;
@@ -120,7 +119,6 @@ class CudaBackend final : public Backend {
   DeviceArray<Float3> model_ground_normals_;  // of the current model's points
   int current_ = 0;
   bool model_initialized_ = false;
-  bool model_points_fetched_ = true;  // host_counts_ holds the current model's point count
 
   // Scratch of the BEV compaction (sources: every model point and every scan pixel).
   DeviceArray<ClosestKey> cell_keys_;
@@ -128,7 +126,8 @@ class CudaBackend final : public Backend {
   DeviceArray<uint32_t> first_sources_;
   DeviceArray<int> source_cells_;
   DeviceArray<int> first_flags_;
-  DeviceArray<int> source_offsets_;
+  DeviceArray<int> tile_firsts_;
+  // The scan of the registration pixels' flags (estimateNormals()).
   size_t scan_scratch_bytes_ = 0;
   DeviceArray<unsigned char> scan_scratch_;
 

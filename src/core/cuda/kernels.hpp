@@ -22,18 +22,19 @@ namespace elo::cuda {
 constexpr uint32_t kNoSource = ~uint32_t{0};  // all bytes 0xff
 
 // Scratch of "closest wins per cell, in order of first arrival" (bev_map.cu). Per BEV cell: the
-// closest-wins key and the lowest source offered to it, both back to "none" after each use. Per source:
-// its cell (-1: none), whether it arrived first in that cell, and the exclusive sum of those flags.
+// closest-wins key and the lowest source offered to it, all back to "none" (all bytes 0xff) after each
+// use. Per source: its cell (-1: none) and whether it arrived first in that cell; per tile of sources
+// (compactionTiles()), its count of first arrivals.
 struct CellCompaction {
   ClosestKey* cell_keys;     // first round: the closest offer per cell
   ClosestKey* surface_keys;  // second round: the oldest offer on its closest surface (model_update.hpp)
   uint32_t* first_sources;
   int* source_cells;
   int* first_flags;
-  int* offsets;
-  void* scan_scratch;  // for exclusiveSum()
-  size_t scan_scratch_bytes;
+  int* tile_firsts;
 };
+// The tiles of `sources` sources, the size of CellCompaction::tile_firsts.
+size_t compactionTiles(size_t sources);
 
 // A list of the flagged items of a range, in order (the registration pixels).
 struct FlaggedList {
@@ -79,10 +80,10 @@ void estimateNormals(const DeviceScan& scan, const NormalParams& params, const F
 // (model_update.hpp), the points in the order the CPU backend inserts them (see bev_map.cu).
 void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
                     const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream);
-// `model_points`: the model's point count; `scan_slots`: a bound on the scan's (its pixel count).
-void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
-                     const BevProjection& projection, const Rigid3f& scan_from_model, const ModelFusion& fusion,
-                     const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream);
+// The point counts of `model` and `scan_ground` are read on the device: nothing waits for them.
+void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const BevProjection& projection,
+                     const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
+                     const CellCompaction& compaction, cudaStream_t stream);
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream);
 void clearGroundMap(const DeviceBev& map, cudaStream_t stream);
 // The normal of every model point (groundNormal() of association.hpp), into `normals`.
@@ -90,10 +91,11 @@ void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, i
                       Float3* normals, cudaStream_t stream);
 
 // model_update.cu: the non-ground model (Sec. III-D).
-// `closest_keys` and `pixel_keys` are scratch for the two rounds (model_update.hpp).
+// `closest_keys` and `surface_keys`, one per pixel, are scratch for the two rounds (model_update.hpp):
+// "none" (all bytes 0xff) before, and again after.
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
                         const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
-                        ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream);
+                        ClosestKey* surface_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
 // correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A), packed as
