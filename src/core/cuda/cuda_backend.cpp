@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <utility>
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/term_sums.hpp"
@@ -16,6 +17,10 @@ static_assert(sizeof(Vec3f) == sizeof(Float3), "Eigen::Vector3f and Float3 must 
 static_assert(sizeof(PixelLabel) == 1, "labels copy byte for byte");
 
 using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
 
 template <typename T>
 void clear(const DeviceArray<T>& array, size_t count, int byte, cudaStream_t stream) {
@@ -62,8 +67,16 @@ CudaBackend::CudaBackend(const Config& config)
       pixels_(static_cast<size_t>(spherical_.rows) * spherical_.cols),
       cells_(static_cast<size_t>(bev_.rows) * bev_.cols) {
   for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  check(cudaGetDevice(&device_), "cudaGetDevice");
   allocate();
   clearDevice();
+}
+
+// No copy may be reading pinned memory, nor a kernel device memory, when the buffers are freed.
+CudaBackend::~CudaBackend() {
+  stager_.wait();
+  cudaStreamSynchronize(upload_stream_.get());
+  cudaStreamSynchronize(stream_.get());
 }
 
 void CudaBackend::allocate() {
@@ -165,59 +178,141 @@ CellCompaction CudaBackend::compaction() const {
           source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
 }
 
-// Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
-void CudaBackend::upload(const PointCloud& cloud, bool with_times) {
+void CudaBackend::UploadBuffers::expect(const HostCloud& cloud) {
+  count = cloud.count;
+  has_rings = cloud.rings != nullptr;
+  has_times = cloud.times != nullptr;
+}
+
+void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
+  check(cudaEventSynchronize(copied.get()), "waiting for the last copy of an upload buffer");
+  check(cudaEventSynchronize(projected.get()), "waiting for the last projection of an upload buffer");
+  if (count == 0) return;
+  staged_points.reserve(count);
+  points.reserve(count);
+  std::memcpy(staged_points.data(), cloud.points, count * sizeof(Float3));
+  if (has_rings) {
+    staged_rings.reserve(count);
+    rings.reserve(count);
+    std::memcpy(staged_rings.data(), cloud.rings, count * sizeof(uint16_t));
+  }
+  if (has_times) {
+    staged_times.reserve(count);
+    times.reserve(count);
+    std::memcpy(staged_times.data(), cloud.times, count * sizeof(float));
+  }
+}
+
+void CudaBackend::UploadBuffers::copy(cudaStream_t stream) {
+  if (count == 0) return;
+  check(cudaMemcpyAsync(points.data(), staged_points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
+        "uploading the cloud");
+  if (has_rings) {
+    check(cudaMemcpyAsync(rings.data(), staged_rings.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice, stream),
+          "uploading the rings");
+  }
+  if (has_times) {
+    check(cudaMemcpyAsync(times.data(), staged_times.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
+          "uploading the per-point times");
+  }
+}
+
+CudaBackend::HostCloud CudaBackend::hostCloud(const PointCloud& cloud, bool with_times) const {
   const size_t count = cloud.points.size();
-  uploaded_rings_ = !ring_rows_.empty() && cloud.ring.size() == count;
-  staged_points_.reserve(count);
-  points_.reserve(count);
-  if (uploaded_rings_) {
-    staged_rings_.reserve(count);
-    rings_.reserve(count);
+  const bool with_rings = !ring_rows_.empty() && cloud.ring.size() == count;
+  return {cloud.points.data(), with_rings ? cloud.ring.data() : nullptr, with_times ? cloud.time.data() : nullptr,
+          count};
+}
+
+// Stages the cloud on stager_ and copies it on upload_stream_, into the buffers the stager did not use
+// last: the scan projected from those (when it was prefetched too) is done with them, or, when it is not,
+// stage() waits until it is. The cloud's times go up when the odometry may deskew by them.
+void CudaBackend::prefetch(const PointCloud& cloud) {
+  const bool with_times = config_.deskew.time_source == TimeSource::field && cloud.time.size() == cloud.points.size();
+  const HostCloud host = hostCloud(cloud, with_times);
+  const int target = 1 - prefetching_;
+  UploadBuffers& buffers = uploads_[target];
+  // The stager's last job on these buffers ended before its job on the others began: only this thread
+  // touches them until run() hands them over.
+  buffers.expect(host);
+  buffers.prefetched = CloudIdentity::of(cloud);
+  buffers.prefetch_error = nullptr;
+  prefetching_ = target;
+  stager_.run([this, &buffers, host] {
+    try {
+      check(cudaSetDevice(device_), "selecting the device");
+      buffers.stage(host);
+      buffers.copy(upload_stream_.get());
+      check(cudaEventRecord(buffers.copied.get(), upload_stream_.get()), "cudaEventRecord");
+    } catch (...) {
+      buffers.prefetch_error = std::current_exception();
+    }
+  });
+}
+
+void CudaBackend::finishPrefetch() noexcept {
+  const Clock::time_point wait_start = Clock::now();
+  stager_.wait();
+  upload_milliseconds_ += millisecondsSince(wait_start);
+}
+
+int CudaBackend::prefetchedUpload(const PointCloud& cloud, bool with_times) const {
+  const CloudIdentity identity = CloudIdentity::of(cloud);
+  for (int buffers = 0; buffers < 2; ++buffers) {
+    const UploadBuffers& upload = uploads_[buffers];
+    if (upload.prefetched == identity && (upload.has_times || !with_times)) return buffers;
   }
-  if (with_times) {
-    staged_times_.reserve(count);
-    times_.reserve(count);
-  }
-  const Clock::time_point staging_start = Clock::now();
-  if (count > 0) {
-    std::memcpy(staged_points_.data(), cloud.points.data(), count * sizeof(Float3));
-    if (uploaded_rings_) std::memcpy(staged_rings_.data(), cloud.ring.data(), count * sizeof(uint16_t));
-    if (with_times) std::memcpy(staged_times_.data(), cloud.time.data(), count * sizeof(float));
-  }
-  upload_milliseconds_ = std::chrono::duration<double, std::milli>(Clock::now() - staging_start).count();
+  return -1;
+}
+
+// A prefetched cloud: the stream waits for its copy, between two events that time the wait. Any other
+// cloud is staged here, into the buffers the stager does not use (dropping a prefetched cloud no
+// projection took), and copied on the stream between the two events.
+const CudaBackend::UploadBuffers& CudaBackend::upload(const PointCloud& cloud, bool with_times) {
   const cudaStream_t stream = stream_.get();
-  check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
-  if (count > 0) {
-    check(cudaMemcpyAsync(points_.data(), staged_points_.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
-          "uploading the cloud");
-    if (uploaded_rings_) {
-      check(cudaMemcpyAsync(rings_.data(), staged_rings_.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice,
-                            stream),
-            "uploading the rings");
-    }
-    if (with_times) {
-      check(cudaMemcpyAsync(times_.data(), staged_times_.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
-            "uploading the per-point times");
-    }
+  const int prefetched = prefetchedUpload(cloud, with_times);
+  if (prefetched >= 0) {
+    UploadBuffers& buffers = uploads_[prefetched];
+    const Clock::time_point wait_start = Clock::now();
+    // The stager finished the jobs before its last one: only that one may still be staging.
+    if (prefetched == prefetching_) stager_.wait();
+    upload_milliseconds_ = millisecondsSince(wait_start);
+    buffers.prefetched.reset();
+    if (buffers.prefetch_error) std::rethrow_exception(std::exchange(buffers.prefetch_error, nullptr));
+    check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
+    check(cudaStreamWaitEvent(stream, buffers.copied.get(), 0), "waiting for the prefetched upload");
+    check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
+    return buffers;
   }
+  UploadBuffers& buffers = uploads_[1 - prefetching_];
+  const HostCloud host = hostCloud(cloud, with_times);
+  buffers.prefetched.reset();
+  buffers.prefetch_error = nullptr;
+  buffers.expect(host);
+  const Clock::time_point staging_start = Clock::now();
+  buffers.stage(host);
+  upload_milliseconds_ = millisecondsSince(staging_start);
+  check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
+  buffers.copy(stream);
   check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
+  return buffers;
 }
 
 size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
   SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
   const bool with_times = deskew.timing.source == TimeSource::field;
-  upload(cloud, with_times);
-  deskew.times = with_times ? times_.data() : nullptr;
+  const UploadBuffers& buffers = upload(cloud, with_times);
+  deskew.times = with_times ? buffers.times.data() : nullptr;
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
-  const UploadedCloud uploaded{points_.data(), uploaded_rings_ ? rings_.data() : nullptr,
-                               static_cast<int>(cloud.points.size())};
+  const UploadedCloud uploaded{buffers.points.data(), buffers.has_rings ? buffers.rings.data() : nullptr,
+                               static_cast<int>(buffers.count)};
   cuda::projectScan(uploaded, spherical_, correction_, deskew, ring_rows_device_.data(),
                     static_cast<int>(ring_rows_.size()), stamp, pixel_keys_.data(), deviceScan(),
                     counts_.data() + kOccupiedPixels, stream_.get());
+  check(cudaEventRecord(buffers.projected.get(), stream_.get()), "cudaEventRecord");
   fetchCount(kOccupiedPixels);
-  synchronize();  // the caller needs the count; the pinned staging buffer is free again after this
+  synchronize();  // the caller needs the count
   float copy_milliseconds = 0.0f;
   check(cudaEventElapsedTime(&copy_milliseconds, upload_start_.get(), upload_end_.get()), "cudaEventElapsedTime");
   upload_milliseconds_ += copy_milliseconds;
