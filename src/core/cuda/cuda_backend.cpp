@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstring>
-#include <utility>
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/term_sums.hpp"
@@ -74,7 +73,7 @@ CudaBackend::CudaBackend(const Config& config)
 
 // No copy may be reading pinned memory, nor a kernel device memory, when the buffers are freed.
 CudaBackend::~CudaBackend() {
-  stager_.wait();
+  uploads_.finish();
   cudaStreamSynchronize(upload_stream_.get());
   cudaStreamSynchronize(stream_.get());
 }
@@ -178,15 +177,12 @@ CellCompaction CudaBackend::compaction() const {
           source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
 }
 
-void CudaBackend::UploadBuffers::expect(const HostCloud& cloud) {
-  count = cloud.count;
-  has_rings = cloud.rings != nullptr;
-  has_times = cloud.times != nullptr;
-}
-
 void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
   check(cudaEventSynchronize(copied.get()), "waiting for the last copy of an upload buffer");
   check(cudaEventSynchronize(projected.get()), "waiting for the last projection of an upload buffer");
+  count = cloud.count;
+  has_rings = cloud.rings != nullptr;
+  has_times = cloud.times != nullptr;
   if (count == 0) return;
   staged_points.reserve(count);
   points.reserve(count);
@@ -224,76 +220,40 @@ CudaBackend::HostCloud CudaBackend::hostCloud(const PointCloud& cloud, bool with
           count};
 }
 
-// Stages the cloud on stager_ and copies it on upload_stream_, into the buffers the stager did not use
-// last: the scan projected from those (when it was prefetched too) is done with them, or, when it is not,
-// stage() waits until it is. The cloud's times go up when the odometry may deskew by them.
+// The cloud's times go up when the odometry may deskew by them. The staging thread reads the cloud's
+// arrays, not the PointCloud, which the caller may move meanwhile.
 void CudaBackend::prefetch(const PointCloud& cloud) {
   const bool with_times = config_.deskew.time_source == TimeSource::field && cloud.time.size() == cloud.points.size();
   const HostCloud host = hostCloud(cloud, with_times);
-  const int target = 1 - prefetching_;
-  UploadBuffers& buffers = uploads_[target];
-  // The stager's last job on these buffers ended before its job on the others began: only this thread
-  // touches them until run() hands them over.
-  buffers.expect(host);
-  buffers.prefetched = CloudIdentity::of(cloud);
-  buffers.prefetch_error = nullptr;
-  prefetching_ = target;
-  stager_.run([this, &buffers, host] {
-    try {
-      check(cudaSetDevice(device_), "selecting the device");
-      buffers.stage(host);
-      buffers.copy(upload_stream_.get());
-      check(cudaEventRecord(buffers.copied.get(), upload_stream_.get()), "cudaEventRecord");
-    } catch (...) {
-      buffers.prefetch_error = std::current_exception();
-    }
+  uploads_.prefetch(CloudIdentity::of(cloud), with_times, [this, host](UploadBuffers& buffers) {
+    check(cudaSetDevice(device_), "selecting the device");
+    buffers.stage(host);
+    buffers.copy(upload_stream_.get());
+    check(cudaEventRecord(buffers.copied.get(), upload_stream_.get()), "cudaEventRecord");
   });
 }
 
 void CudaBackend::finishPrefetch() noexcept {
   const Clock::time_point wait_start = Clock::now();
-  stager_.wait();
+  uploads_.finish();
   upload_milliseconds_ += millisecondsSince(wait_start);
 }
 
-int CudaBackend::prefetchedUpload(const PointCloud& cloud, bool with_times) const {
-  const CloudIdentity identity = CloudIdentity::of(cloud);
-  for (int buffers = 0; buffers < 2; ++buffers) {
-    const UploadBuffers& upload = uploads_[buffers];
-    if (upload.prefetched == identity && (upload.has_times || !with_times)) return buffers;
-  }
-  return -1;
-}
-
 // A prefetched cloud: the stream waits for its copy, between two events that time the wait. Any other
-// cloud is staged here, into the buffers the stager does not use (dropping a prefetched cloud no
-// projection took), and copied on the stream between the two events.
+// cloud is staged here and copied on the stream between the two events.
 const CudaBackend::UploadBuffers& CudaBackend::upload(const PointCloud& cloud, bool with_times) {
   const cudaStream_t stream = stream_.get();
-  const int prefetched = prefetchedUpload(cloud, with_times);
-  if (prefetched >= 0) {
-    UploadBuffers& buffers = uploads_[prefetched];
-    const Clock::time_point wait_start = Clock::now();
-    // The stager finished the jobs before its last one: only that one may still be staging.
-    if (prefetched == prefetching_) stager_.wait();
-    upload_milliseconds_ = millisecondsSince(wait_start);
-    buffers.prefetched.reset();
-    if (buffers.prefetch_error) std::rethrow_exception(std::exchange(buffers.prefetch_error, nullptr));
-    check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
-    check(cudaStreamWaitEvent(stream, buffers.copied.get(), 0), "waiting for the prefetched upload");
-    check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
-    return buffers;
-  }
-  UploadBuffers& buffers = uploads_[1 - prefetching_];
-  const HostCloud host = hostCloud(cloud, with_times);
-  buffers.prefetched.reset();
-  buffers.prefetch_error = nullptr;
-  buffers.expect(host);
-  const Clock::time_point staging_start = Clock::now();
-  buffers.stage(host);
-  upload_milliseconds_ = millisecondsSince(staging_start);
+  const Clock::time_point start = Clock::now();
+  const auto taken = uploads_.take(CloudIdentity::of(cloud), with_times);
+  UploadBuffers& buffers = taken.buffers;
+  if (!taken.prefetched) buffers.stage(hostCloud(cloud, with_times));
+  upload_milliseconds_ = millisecondsSince(start);
   check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
-  buffers.copy(stream);
+  if (taken.prefetched) {
+    check(cudaStreamWaitEvent(stream, buffers.copied.get(), 0), "waiting for the prefetched upload");
+  } else {
+    buffers.copy(stream);
+  }
   check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
   return buffers;
 }

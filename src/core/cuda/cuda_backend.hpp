@@ -6,13 +6,10 @@
 // processed. The host views are copied back when asked for, and only when the device buffers changed since.
 #pragma once
 
-#include <exception>
-#include <optional>
 #include <vector>
 
-#include "core/background_task.hpp"
-#include "core/cloud_identity.hpp"
 #include "core/cuda/device_buffer.hpp"
+#include "core/double_buffered_upload.hpp"
 #include "core/cuda/kernels.hpp"
 #include "elo/backend.hpp"
 
@@ -71,9 +68,9 @@ class CudaBackend final : public Backend {
     const float* times = nullptr;
     size_t count = 0;
   };
-  // One scan's upload: the cloud staged in pinned memory and copied to the device. Staging waits until
-  // the copy that read the pinned memory last (`copied`) and the projection that read the device copy
-  // last (`projected`) are done.
+  // One scan's upload (DoubleBufferedUpload): the cloud staged in pinned memory and copied to the device.
+  // Staging waits until the copy that read the pinned memory last (`copied`) and the projection that read
+  // the device copy last (`projected`) are done.
   struct UploadBuffers {
     PinnedArray<Float3> staged_points;
     PinnedArray<uint16_t> staged_rings;
@@ -83,17 +80,12 @@ class CudaBackend final : public Backend {
     DeviceArray<float> times;
     Event copied{cudaEventDisableTiming};
     Event projected{cudaEventDisableTiming};
-    // What the buffers hold, set by expect() on the thread that hands the upload over, before it starts:
-    // the points, and whether their rings and times are there.
+    // The points staged, and whether their rings and times are there.
     size_t count = 0;
     bool has_rings = false;
     bool has_times = false;
-    // The cloud prefetch() staged here and no projection took yet, and why staging it failed.
-    std::optional<CloudIdentity> prefetched;
-    std::exception_ptr prefetch_error;
 
-    void expect(const HostCloud& cloud);
-    // Copies `cloud` (what expect() was told) into the pinned memory, growing the buffers as needed.
+    // Copies `cloud` into the pinned memory, growing the buffers as needed.
     void stage(const HostCloud& cloud);
     // Queues the copy of the staged cloud to the device on `stream`.
     void copy(cudaStream_t stream);
@@ -106,8 +98,6 @@ class CudaBackend final : public Backend {
   // waits for their prefetched upload; returns the buffers that hold them on the device. Records
   // upload_start_ and upload_end_ on the stream around the copy, or the wait for it.
   const UploadBuffers& upload(const PointCloud& cloud, bool with_times);
-  // The upload buffers prefetch() staged `cloud` into, with its times when `with_times`; -1 when none.
-  int prefetchedUpload(const PointCloud& cloud, bool with_times) const;
   DeviceScan deviceScan() const;
   DeviceModelImage deviceModel(int buffer) const;
   DeviceBev deviceBev(const BevBuffers& buffers, int count) const;
@@ -133,17 +123,10 @@ class CudaBackend final : public Backend {
 
   int device_ = 0;  // the thread that stages prefetched uploads works on it too
   Stream stream_;
+  Stream upload_stream_;  // the prefetched uploads' copies
   Event upload_start_;
   Event upload_end_;
   double upload_milliseconds_ = 0.0;
-
-  // The scans' uploads. prefetch() stages into uploads_[prefetching_] on stager_ and copies on
-  // upload_stream_; an upload that was not prefetched goes into the other buffers, on stream_. So the
-  // stager only ever touches uploads_[prefetching_], and the scan before its cloud, projected from the
-  // other buffers, never waits for it.
-  UploadBuffers uploads_[2];
-  int prefetching_ = 1;
-  Stream upload_stream_;
   DeviceArray<int> ring_rows_device_;
 
   // The scan image, its registration pixels and its ground map.
@@ -194,8 +177,9 @@ class CudaBackend final : public Backend {
   bool scan_ground_view_current_ = false;
   bool model_view_current_ = false;
 
-  // Last: it stops, finishing its job, before the buffers its jobs write go.
-  BackgroundTask stager_;
+  // The scans' uploads: a prefetched cloud is staged on the uploads' own thread and copied on
+  // upload_stream_, any other one here and on stream_. Last: its thread stops before the streams go.
+  DoubleBufferedUpload<UploadBuffers> uploads_;
 };
 
 }  // namespace elo::cuda
