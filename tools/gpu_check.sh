@@ -110,6 +110,7 @@ echo
 printf '%-34s %8s %9s %9s %10s %10s %9s\n' "bench, f2m" "points" "CPU FPS" "CUDA FPS" "ms/scan" \
   "w/o upload" "upload ms"
 printf '%s\n' "${bench[@]}"
-echo "(CPU: all $(nproc) threads. CUDA FPS and ms/scan include the scan's upload; 'w/o upload' is the FPS without it.)"
+echo "(CPU: all $(nproc) threads. CUDA FPS and ms/scan include the scan's upload; 'upload ms' is what of it the"
+echo " frames still waited for, elo_run prefetching each scan while the one before it runs; 'w/o upload' leaves that out.)"
 [ -n "${GPU_CHECK_LOG:-}" ] && cp "$work"/*.log "$GPU_CHECK_LOG"/ 2>/dev/null
 exit $((failures > 0))

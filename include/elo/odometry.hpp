@@ -55,6 +55,14 @@ class Odometry {
   // the model at the current pose (FrameResult::gap_restart).
   FrameResult process(const PointCloud& cloud);
 
+  // Hands over the scan a later process() call will be given, normally the call after the next one, so
+  // that a device backend uploads it while the next call processes its scan (Backend::prefetch(),
+  // docs/cuda.md). Only a speed-up: process() gives the same results, bit for bit, whatever was
+  // prefetched, and takes the upload for the same cloud only (the same arrays' memory and lengths, and the
+  // same stamp; a cloud moved to another PointCloud is the same). `cloud` must stay alive until the next
+  // process() call returns, and must not change until it is processed.
+  void prefetch(const PointCloud& cloud) { backend_->prefetch(cloud); }
+
   // Forgets the model, the motion and the pose: the next scan starts a new trajectory at identity.
   void reset();
 
@@ -85,6 +93,8 @@ class Odometry {
   size_t minOccupiedPixels() const;
 
  private:
+  // process() but for the total time and the end of the prefetch.
+  FrameResult processScan(const PointCloud& cloud);
   FrameResult skip(const std::string& reason);
   // Forgets the model and the motion but keeps the pose: the next scan continues the trajectory from it.
   void restartModel();

@@ -380,6 +380,85 @@ TEST(BackendAgreement, GpuRunsAreReproducible) {
   }
 }
 
+// Sweeps down the street at 10 m/s while turning: points with rings and per-point times.
+PointCloud streetSweep(const Config& config, int frame) {
+  Vector6d velocity;
+  velocity << 10.0, 0.0, 0.0, 0.0, 0.0, 0.12;
+  const Eigen::Isometry3d truth = pose(-25, 0, 0, 0, 0, 0) * expSE3(0.1 * frame * velocity);
+  return test::sweepScene(test::streetScene(), config.sensor, truth, velocity, 0.1 * frame).cloud;
+}
+
+// A prefetched upload (Backend::prefetch()) is taken for its own cloud only, and projects as the same
+// cloud uploaded by the projection: another cloud projected in between, clouds prefetched one, two and
+// three ahead (the first two then dropped), the same cloud twice, a cloud prefetched without the times
+// its projection deskews by (deskew.time_source azimuth), and a scan with fewer points than the last.
+TEST(BackendAgreement, ProjectionTakesAPrefetchedUploadOnlyForItsCloud) {
+  ELO_REQUIRE_CUDA();
+  for (const TimeSource prefetched_times : {TimeSource::field, TimeSource::azimuth}) {
+    SCOPED_TRACE(prefetched_times == TimeSource::field ? "times prefetched" : "times not prefetched");
+    Config config;
+    config.runtime.backend = BackendKind::cuda;
+    config.deskew.time_source = prefetched_times;
+    std::vector<PointCloud> clouds;
+    for (int frame = 0; frame < 4; ++frame) clouds.push_back(streetSweep(config, frame));
+    clouds[3].points.resize(clouds[3].size() / 2);
+    clouds[3].ring.resize(clouds[3].size());
+    clouds[3].time.resize(clouds[3].size());
+    Vector6d velocity;
+    velocity << 9.0, 0.0, 0.0, 0.0, 0.0, 0.1;
+    const std::unique_ptr<Backend> plain = makeBackend(config);
+    const std::unique_ptr<Backend> prefetching = makeBackend(config);
+    const auto expectSameScan = [&](const PointCloud& cloud, const std::string& what) {
+      SCOPED_TRACE(what);
+      const SweepMotion motion{TimeSource::field, velocity, 0.0};
+      const float stamp = static_cast<float>(cloud.stamp);
+      EXPECT_EQ(plain->projectScan(cloud, stamp, motion), prefetching->projectScan(cloud, stamp, motion));
+      expectSameProjection(plain->scan(), prefetching->scan());
+      EXPECT_EQ(plain->scan().time, prefetching->scan().time);
+      EXPECT_EQ(plain->scan().measured, prefetching->scan().measured);
+    };
+    prefetching->prefetch(clouds[0]);
+    expectSameScan(clouds[1], "another cloud than the one prefetched");
+    expectSameScan(clouds[0], "the cloud prefetched before another was projected");
+    for (int ahead = 1; ahead < 4; ++ahead) prefetching->prefetch(clouds[ahead]);
+    for (int ahead = 1; ahead < 4; ++ahead) expectSameScan(clouds[ahead], "prefetched " + std::to_string(ahead) + " ahead");
+    prefetching->prefetch(clouds[2]);
+    prefetching->prefetch(clouds[2]);
+    expectSameScan(clouds[2], "prefetched twice");
+    expectSameScan(clouds[2], "projected again, from its second prefetched upload");
+    prefetching->finishPrefetch();
+  }
+}
+
+// elo_run's order: each scan prefetched before the scan before it is processed, then moved to where it
+// is processed from; and a prefetched scan the odometry skips (a repeated stamp).
+TEST(BackendAgreement, PrefetchedScansGiveTheSamePosesBitForBit) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  Odometry plain(config);
+  Odometry prefetching(config);
+  constexpr int kFrames = 8;
+  PointCloud next = streetSweep(config, 0);
+  prefetching.prefetch(next);
+  for (int frame = 0; frame < kFrames; ++frame) {
+    const PointCloud current = std::move(next);
+    if (frame + 1 < kFrames) {
+      next = streetSweep(config, frame + 1);
+      prefetching.prefetch(next);
+    }
+    const FrameResult a = plain.process(current);
+    const FrameResult b = prefetching.process(current);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    EXPECT_EQ(a.deskew_rounds, b.deskew_rounds) << "frame " << frame;
+    EXPECT_EQ(a.pose.matrix(), b.pose.matrix()) << "frame " << frame;
+    const PointCloud repeated = current;
+    prefetching.prefetch(repeated);
+    EXPECT_EQ(prefetching.process(repeated).skip_reason, "duplicate stamp") << "frame " << frame;
+    if (frame + 1 < kFrames) prefetching.prefetch(next);
+  }
+}
+
 TEST(BackendFactory, CudaWithoutAUsableGpuFailsSayingWhy) {
   const std::string reason = cudaUnavailableReason();
   if (reason.empty()) GTEST_SKIP() << "a CUDA device is usable here";

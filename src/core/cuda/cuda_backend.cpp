@@ -17,6 +17,10 @@ static_assert(sizeof(PixelLabel) == 1, "labels copy byte for byte");
 
 using Clock = std::chrono::steady_clock;
 
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
 template <typename T>
 void clear(const DeviceArray<T>& array, size_t count, int byte, cudaStream_t stream) {
   check(cudaMemsetAsync(array.data(), byte, count * sizeof(T), stream), "cudaMemsetAsync");
@@ -62,8 +66,16 @@ CudaBackend::CudaBackend(const Config& config)
       pixels_(static_cast<size_t>(spherical_.rows) * spherical_.cols),
       cells_(static_cast<size_t>(bev_.rows) * bev_.cols) {
   for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  check(cudaGetDevice(&device_), "cudaGetDevice");
   allocate();
   clearDevice();
+}
+
+// No copy may be reading pinned memory, nor a kernel device memory, when the buffers are freed.
+CudaBackend::~CudaBackend() {
+  uploads_.finish();
+  cudaStreamSynchronize(upload_stream_.get());
+  cudaStreamSynchronize(stream_.get());
 }
 
 void CudaBackend::allocate() {
@@ -164,59 +176,102 @@ CellCompaction CudaBackend::compaction() const {
           source_cells_.data(), first_flags_.data(),  tile_firsts_.data()};
 }
 
-// Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
-void CudaBackend::upload(const PointCloud& cloud, bool with_times) {
+void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
+  check(cudaEventSynchronize(copied.get()), "waiting for the last copy of an upload buffer");
+  check(cudaEventSynchronize(projected.get()), "waiting for the last projection of an upload buffer");
+  count = cloud.count;
+  has_rings = cloud.rings != nullptr;
+  has_times = cloud.times != nullptr;
+  if (count == 0) return;
+  staged_points.reserve(count);
+  points.reserve(count);
+  std::memcpy(staged_points.data(), cloud.points, count * sizeof(Float3));
+  if (has_rings) {
+    staged_rings.reserve(count);
+    rings.reserve(count);
+    std::memcpy(staged_rings.data(), cloud.rings, count * sizeof(uint16_t));
+  }
+  if (has_times) {
+    staged_times.reserve(count);
+    times.reserve(count);
+    std::memcpy(staged_times.data(), cloud.times, count * sizeof(float));
+  }
+}
+
+void CudaBackend::UploadBuffers::copy(cudaStream_t stream) {
+  if (count == 0) return;
+  check(cudaMemcpyAsync(points.data(), staged_points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
+        "uploading the cloud");
+  if (has_rings) {
+    check(cudaMemcpyAsync(rings.data(), staged_rings.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice, stream),
+          "uploading the rings");
+  }
+  if (has_times) {
+    check(cudaMemcpyAsync(times.data(), staged_times.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
+          "uploading the per-point times");
+  }
+}
+
+CudaBackend::HostCloud CudaBackend::hostCloud(const PointCloud& cloud, bool with_times) const {
   const size_t count = cloud.points.size();
-  uploaded_rings_ = !ring_rows_.empty() && cloud.ring.size() == count;
-  staged_points_.reserve(count);
-  points_.reserve(count);
-  if (uploaded_rings_) {
-    staged_rings_.reserve(count);
-    rings_.reserve(count);
-  }
-  if (with_times) {
-    staged_times_.reserve(count);
-    times_.reserve(count);
-  }
-  const Clock::time_point staging_start = Clock::now();
-  if (count > 0) {
-    std::memcpy(staged_points_.data(), cloud.points.data(), count * sizeof(Float3));
-    if (uploaded_rings_) std::memcpy(staged_rings_.data(), cloud.ring.data(), count * sizeof(uint16_t));
-    if (with_times) std::memcpy(staged_times_.data(), cloud.time.data(), count * sizeof(float));
-  }
-  upload_milliseconds_ = std::chrono::duration<double, std::milli>(Clock::now() - staging_start).count();
+  const bool with_rings = !ring_rows_.empty() && cloud.ring.size() == count;
+  return {cloud.points.data(), with_rings ? cloud.ring.data() : nullptr, with_times ? cloud.time.data() : nullptr,
+          count};
+}
+
+// The cloud's times go up when the odometry may deskew by them. The staging thread reads the cloud's
+// arrays, not the PointCloud, which the caller may move meanwhile.
+void CudaBackend::prefetch(const PointCloud& cloud) {
+  const bool with_times = config_.deskew.time_source == TimeSource::field && cloud.time.size() == cloud.points.size();
+  const HostCloud host = hostCloud(cloud, with_times);
+  uploads_.prefetch(CloudIdentity::of(cloud), with_times, [this, host](UploadBuffers& buffers) {
+    check(cudaSetDevice(device_), "selecting the device");
+    buffers.stage(host);
+    buffers.copy(upload_stream_.get());
+    check(cudaEventRecord(buffers.copied.get(), upload_stream_.get()), "cudaEventRecord");
+  });
+}
+
+void CudaBackend::finishPrefetch() noexcept {
+  const Clock::time_point wait_start = Clock::now();
+  uploads_.finish();
+  upload_milliseconds_ += millisecondsSince(wait_start);
+}
+
+// A prefetched cloud: the stream waits for its copy, between two events that time the wait. Any other
+// cloud is staged here and copied on the stream between the two events.
+const CudaBackend::UploadBuffers& CudaBackend::upload(const PointCloud& cloud, bool with_times) {
   const cudaStream_t stream = stream_.get();
+  const Clock::time_point start = Clock::now();
+  const auto taken = uploads_.take(CloudIdentity::of(cloud), with_times);
+  UploadBuffers& buffers = taken.buffers;
+  if (!taken.prefetched) buffers.stage(hostCloud(cloud, with_times));
+  upload_milliseconds_ = millisecondsSince(start);
   check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
-  if (count > 0) {
-    check(cudaMemcpyAsync(points_.data(), staged_points_.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
-          "uploading the cloud");
-    if (uploaded_rings_) {
-      check(cudaMemcpyAsync(rings_.data(), staged_rings_.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice,
-                            stream),
-            "uploading the rings");
-    }
-    if (with_times) {
-      check(cudaMemcpyAsync(times_.data(), staged_times_.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
-            "uploading the per-point times");
-    }
+  if (taken.prefetched) {
+    check(cudaStreamWaitEvent(stream, buffers.copied.get(), 0), "waiting for the prefetched upload");
+  } else {
+    buffers.copy(stream);
   }
   check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
+  return buffers;
 }
 
 size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
   SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
   const bool with_times = deskew.timing.source == TimeSource::field;
-  upload(cloud, with_times);
-  deskew.times = with_times ? times_.data() : nullptr;
+  const UploadBuffers& buffers = upload(cloud, with_times);
+  deskew.times = with_times ? buffers.times.data() : nullptr;
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
-  const UploadedCloud uploaded{points_.data(), uploaded_rings_ ? rings_.data() : nullptr,
-                               static_cast<int>(cloud.points.size())};
+  const UploadedCloud uploaded{buffers.points.data(), buffers.has_rings ? buffers.rings.data() : nullptr,
+                               static_cast<int>(buffers.count)};
   cuda::projectScan(uploaded, spherical_, correction_, deskew, ring_rows_device_.data(),
                     static_cast<int>(ring_rows_.size()), stamp, pixel_keys_.data(), deviceScan(),
                     counts_.data() + kOccupiedPixels, stream_.get());
+  check(cudaEventRecord(buffers.projected.get(), stream_.get()), "cudaEventRecord");
   fetchCount(kOccupiedPixels);
-  synchronize();  // the caller needs the count; the pinned staging buffer is free again after this
+  synchronize();  // the caller needs the count
   float copy_milliseconds = 0.0f;
   check(cudaEventElapsedTime(&copy_milliseconds, upload_start_.get(), upload_end_.get()), "cudaEventElapsedTime");
   upload_milliseconds_ += copy_milliseconds;
