@@ -198,6 +198,27 @@ TEST(BackendAgreement, NormalsAgreeForEveryMethod) {
   }
 }
 
+// The GPU reads each window from its block's tile in shared memory: windows too large for a block's tile
+// stop the CUDA backend with an error that names the parameters to change.
+TEST(BackendAgreement, WindowsTooLargeForATileStopTheCudaBackendNamingTheParameters) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.normals.max_window_width = 81;
+  config.normals.max_window_height = 41;
+  config.runtime.backend = BackendKind::cuda;
+  const std::unique_ptr<Backend> backend = makeBackend(config);
+  backend->projectScan(streetScan(config), 0.0f);
+  backend->segmentGround();
+  try {
+    backend->estimateNormals();
+    ADD_FAILURE() << "81 x 41 windows need 86,016 bytes of shared memory per block, and ran";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("normals.max_window_width x normals.max_window_height"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(BackendAgreement, ScanGroundMapsAreIdenticalInTheSameOrder) {
   ELO_REQUIRE_CUDA();
   const Config config;

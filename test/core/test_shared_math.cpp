@@ -318,8 +318,9 @@ TileComparison compareTilesWithWholeScan(const Config& config, int block_rows, i
 }
 
 // The tiles hold every pixel the windows reach, wrapping around the image's ends as the windows do: the
-// kernel's 8 x 32 blocks, and odd shapes that end inside the image, on images narrower than one tile with
-// its halo (each column in it twice) and wider ones whose width no block shape divides.
+// kernel's 8 x 32 blocks, and on the narrower images odd shapes that end inside the image too; images
+// narrower than one tile with its halo (some columns in it twice) and wider ones whose width no block
+// shape divides.
 TEST(NormalTile, NormalsFromTheTilesAreThoseFromTheWholeScanBitForBit) {
   for (const NormalMethod method : {NormalMethod::range_adaptive, NormalMethod::eigen, NormalMethod::cross_product}) {
     for (const int width : {2048, 1000, 24}) {
@@ -328,6 +329,7 @@ TEST(NormalTile, NormalsFromTheTilesAreThoseFromTheWholeScanBitForBit) {
       config.sensor.image_width = width;
       config.runtime.threads = 2;
       for (const auto& [block_rows, block_cols] : {std::pair{8, 32}, std::pair{3, 7}}) {
+        if (width == 2048 && block_cols != 32) continue;  // the full image only as the kernel tiles it: time
         SCOPED_TRACE("method " + std::to_string(static_cast<int>(method)) + ", width " + std::to_string(width) +
                      ", blocks " + std::to_string(block_rows) + " x " + std::to_string(block_cols));
         const TileComparison comparison = compareTilesWithWholeScan(config, block_rows, block_cols);

@@ -1,8 +1,9 @@
 // Sec. III-B.3-4, Eq. 10-12: the normal of one pixel of the non-ground range image, by the range-adaptive
-// estimator or the Table III baselines. The CUDA backend runs pixelNormal() once per pixel. The CPU
-// backend gathers the windows with vectorised masked sums instead (normal_estimation.cpp) and shares the
-// rest; gatherWindow() adds in the order and with the roundings of those sums, so both backends get the
-// same normals bit for bit, which a CPU test checks.
+// estimator or the Table III baselines. The CUDA backend runs pixelNormal() once per pixel, on a tile of
+// the scan in shared memory (cuda/normal_tile.hpp). The CPU backend gathers the windows with vectorised
+// masked sums instead (normal_estimation.cpp) and shares the rest; gatherWindow() adds in the order and
+// with the roundings of those sums, so both backends get the same normals bit for bit, which a CPU test
+// checks.
 //
 // An Image provides `rows`, `cols`, `bool usable(int pixel)` (a non-ground pixel), `Float3 vertex(int
 // pixel)` and `float range(int pixel)`.

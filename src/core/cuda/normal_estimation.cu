@@ -60,11 +60,11 @@ void estimateNormals(const DeviceScan& scan, const NormalParams& params, const F
                      cudaStream_t stream) {
   const size_t shared_bytes = sizeof(TilePixel) * static_cast<size_t>(blockTile(params, 0, 0).slots());
   if (shared_bytes > kSharedBytesPerBlock) {
-    throw std::runtime_error("CUDA backend: a normals window of normals.max_window_width x normals.max_window_height (" +
+    throw std::runtime_error("CUDA backend: normals.max_window_width x normals.max_window_height (" +
                              std::to_string(params.max_window_width) + " x " +
                              std::to_string(params.max_window_height) + ") needs " + std::to_string(shared_bytes) +
-                             " bytes of shared memory per block of pixels, more than the " +
-                             std::to_string(kSharedBytesPerBlock) + " a block can have");
+                             " bytes of shared memory per block, more than the " +
+                             std::to_string(kSharedBytesPerBlock) + " a block can have: use smaller windows");
   }
   const dim3 tiles((scan.cols + kTileCols - 1) / kTileCols, (scan.rows + kTileRows - 1) / kTileRows);
   pixelNormals<<<tiles, kThreads, shared_bytes, stream>>>(scan, params, registration_pixels.flags);
