@@ -214,33 +214,17 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
   }
 }
 
-// groundNormals: a warp per block, each thread's patch of the grid (radius up to kCopiedPatchRadius, the
-// default's) copied into its own column of shared memory (GroundPatch). Searched in place, the map cost
-// each thread a chain of dependent loads per visited cell, on a grid with few threads per SM.
-constexpr int kNormalThreads = 32;
-constexpr int kCopiedPatchRadius = 3;
-constexpr int kCopiedPatchSlots = (2 * kCopiedPatchRadius + 1) * (2 * kCopiedPatchRadius + 1);
+// One thread per model point: its patch search (groundNormal()) stops after a ring or two, a chain of
+// dependent loads that the GPU hides only with many threads in flight, more than the usual grid-stride
+// grid holds. (Copying each thread's whole patch to shared memory first loaded every cell of it, and was
+// slower.)
+constexpr int kNormalBlocks = 4 * kGridStrideBlocks;
 
-__global__ void __launch_bounds__(kNormalThreads)
-    groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius, Float3* normals) {
-  __shared__ uint8_t occupied[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float x[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float y[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float z[kCopiedPatchSlots][kNormalThreads];
+__global__ void groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius,
+                              Float3* normals) {
   const int count = *model.count;
-  const int lane = static_cast<int>(threadIdx.x);
   for (int point = globalThread(); point < count; point += gridThreads()) {
-    if (patch_radius > kCopiedPatchRadius) {
-      normals[point] = groundNormal(model, projection, point, wanted, patch_radius);
-      continue;
-    }
-    const int cell = model.cells[point];
-    const int row = cell / projection.cols;
-    const int col = cell % projection.cols;
-    const GroundPatch patch{row - patch_radius, col - patch_radius, 2 * patch_radius + 1, projection.cols,
-                            kNormalThreads, &occupied[0][lane], &x[0][lane], &y[0][lane], &z[0][lane]};
-    copyGroundPatch(model, projection, patch);
-    normals[point] = groundNormalAt(patch, projection, model.vertices[point], row, col, wanted, patch_radius);
+    normals[point] = groundNormal(model, projection, point, wanted, patch_radius);
   }
 }
 
@@ -275,9 +259,7 @@ void clearGroundMap(const DeviceBev& map, cudaStream_t stream) {
 
 void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
                       Float3* normals, cudaStream_t stream) {
-  // The same 65,536 threads as every grid-stride kernel, in blocks of one warp.
-  groundNormals<<<kGridStrideBlocks * kThreads / kNormalThreads, kNormalThreads, 0, stream>>>(
-      model, projection, wanted, patch_radius, normals);
+  groundNormals<<<kNormalBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
   checkLaunch("groundNormals");
 }
 
