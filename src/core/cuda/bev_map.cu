@@ -215,11 +215,8 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
 }
 
 // One thread per model point: its patch search (groundNormal()) stops after a ring or two, a chain of
-// dependent loads that the GPU hides only with many threads in flight, more than the usual grid-stride
-// grid holds. (Copying each thread's whole patch to shared memory first loaded every cell of it, and was
-// slower.)
-constexpr int kNormalBlocks = 4 * kGridStrideBlocks;
-
+// dependent loads that the GPU hides only with many threads in flight (kWideGridBlocks). Copying each
+// thread's whole patch to shared memory first loaded every cell of it, and was slower.
 __global__ void groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius,
                               Float3* normals) {
   const int count = *model.count;
@@ -241,7 +238,7 @@ void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const
                      const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
                      const CellCompaction& compaction, cudaStream_t stream) {
   const FusionSources sources{model, scan_ground, scan_from_model, fusion, 0, 0};
-  compact(sources, kGridStrideBlocks, projection, fusion.same_surface_distance, compaction, fused, stream);
+  compact(sources, kWideGridBlocks, projection, fusion.same_surface_distance, compaction, fused, stream);
 }
 
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream) {
@@ -259,7 +256,7 @@ void clearGroundMap(const DeviceBev& map, cudaStream_t stream) {
 
 void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
                       Float3* normals, cudaStream_t stream) {
-  groundNormals<<<kNormalBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
+  groundNormals<<<kWideGridBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
   checkLaunch("groundNormals");
 }
 
