@@ -18,14 +18,6 @@
 #define ELO_HOST_DEVICE
 #endif
 
-// Unrolls the loop that follows in device code, where a loop over a fixed-size local array must be
-// unrolled for the array to stay in registers; the host compilers decide for themselves.
-#if defined(__CUDA_ARCH__)
-#define ELO_UNROLL _Pragma("unroll")
-#else
-#define ELO_UNROLL
-#endif
-
 namespace elo {
 
 enum class PixelLabel : uint8_t { empty = 0, nonground = 1, ground = 2 };

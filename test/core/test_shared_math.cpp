@@ -2,16 +2,13 @@
 // most of it, so the stage tests cover it too; these tests cover what is new or only the CUDA backend
 // runs: the ported eigen-solver, the keys, transforms and point-to-plane terms, windowNormal(), the
 // scalar normal estimator of the GPU, against the CPU backend's vectorised one, the GPU's tiles of the scan
-// it reads its windows from, the GPU's per-pixel ground labels against the CPU's column walk, and the GPU's
-// ground normals from a copied patch against the CPU's from the map.
+// it reads its windows from, and the GPU's per-pixel ground labels against the CPU's column walk.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
-#include <cstring>
 #include <random>
 
 #include "analytic_scene.hpp"
-#include "core/common/association.hpp"
 #include "core/common/closest_wins_key.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/common/ground.hpp"
@@ -127,61 +124,6 @@ TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsARing) {
   std::vector<Float3> ring;
   for (int i = 0; i < 5; ++i) ring.push_back({10.0f + 0.1f * i, 2.0f, -1.73f});  // one line in x-y
   EXPECT_TRUE(isZero(groundPlaneNormal(ring.data(), 5, ring[0])));
-}
-
-// A ground map of a tilted road on a small grid: two cells in three hold a point, every other one at
-// its cell's centre (so that many neighbours lie at exactly equal distances, and the order they are
-// visited in decides which are kept), the rest scattered in their cells.
-BevImage tiltedRoadMap(const BevProjection& projection) {
-  BevImage map;
-  map.resize(projection.rows, projection.cols);
-  std::mt19937 random(11);
-  std::uniform_real_distribution<float> within(0.0f, 1.0f);
-  for (int cell = 0; cell < projection.rows * projection.cols; ++cell) {
-    if (cell % 3 == 2) continue;
-    const float u = cell % 2 == 0 ? 0.5f : within(random);
-    const float v = cell % 2 == 0 ? 0.5f : within(random);
-    const float x = (static_cast<float>(cell % projection.cols) + u) * projection.cell_size - projection.half_length;
-    const float y = (static_cast<float>(cell / projection.cols) + v) * projection.cell_size - projection.half_width;
-    map.point_of_cell[cell] = static_cast<int32_t>(map.cell.size());
-    map.cell.push_back(cell);
-    map.vertex.emplace_back(x, y, 0.04f * x - 0.02f * y - 1.7f + 0.01f * within(random));
-  }
-  return map;
-}
-
-TEST(GroundPatch, NormalsFromACopiedPatchAreTheMapsBitForBit) {
-  BevConfig config;
-  config.half_length = 1.2;
-  config.half_width = 0.8;
-  const BevProjection projection = BevProjection::fromConfig(config);
-  const BevImage map = tiltedRoadMap(projection);
-  const cpu::GroundPoints points(map);
-  // Patches interleaved as the GPU's threads interleave theirs: this one is lane 1 of 3.
-  constexpr int kStride = 3;
-  for (int radius = 1; radius <= 3; ++radius) {
-    const int side = 2 * radius + 1;
-    std::vector<uint8_t> occupied(side * side * kStride, 7);
-    std::vector<float> x(occupied.size(), NAN);
-    std::vector<float> y(occupied.size(), NAN);
-    std::vector<float> z(occupied.size(), NAN);
-    for (const int wanted : {3, 5, 9, 32}) {
-      int with_normal = 0;
-      for (int32_t point = 0; point < static_cast<int32_t>(map.size()); ++point) {
-        const int row = map.cell[point] / projection.cols;
-        const int col = map.cell[point] % projection.cols;
-        const GroundPatch patch{row - radius, col - radius, side,     projection.cols, kStride,
-                                &occupied[1],    &x[1],          &y[1], &z[1]};
-        copyGroundPatch(points, projection, patch);
-        const Float3 expected = groundNormal(points, projection, point, wanted, radius);
-        const Float3 copied = groundNormalAt(patch, projection, points.vertex(point), row, col, wanted, radius);
-        ASSERT_EQ(std::memcmp(&expected, &copied, sizeof(Float3)), 0)
-            << "point " << point << ", radius " << radius << ", wanted " << wanted;
-        with_normal += !isZero(expected);
-      }
-      EXPECT_GT(with_normal, static_cast<int>(map.size()) / 2) << "radius " << radius << ", wanted " << wanted;
-    }
-  }
 }
 
 TEST(ClosestWinsKey, CloserWinsTiesGoToTheLowerSourceAndNoneLosesToAll) {

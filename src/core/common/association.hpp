@@ -167,14 +167,17 @@ ELO_HOST_DEVICE bool groundMatch(const BevProjection& projection, const GroundMa
   return match >= 0 && !(squaredDistance(model.vertex(match), moved) > gates.max_distance_squared);
 }
 
-// The normal at `centre`, a model point in cell (row, col) (Sec. III-C.2): the plane of the `wanted` model
-// points nearest to it (itself included) within `patch_radius` rings of cells; zero when they give no
-// plane. Rings are searched outwards; once the farthest kept point is closer than any point of the next
-// ring can be (ring - 1 cells, as the centre may lie at the edge of its own cell), the rest cannot change
-// the result.
+// The normal of model point `point` (Sec. III-C.2): the plane of the `wanted` model points nearest to it
+// (itself included) within `patch_radius` rings of cells; zero when they give no plane. Rings are
+// searched outwards; once the farthest kept point is closer than any point of the next ring can be
+// (ring - 1 cells, as the centre may lie at the edge of its own cell), the rest cannot change the result.
 template <typename GroundMap>
-ELO_HOST_DEVICE Float3 groundNormalAt(const GroundMap& map, const BevProjection& projection, const Float3& centre,
-                                      int row, int col, int wanted, int patch_radius) {
+ELO_HOST_DEVICE Float3 groundNormal(const GroundMap& map, const BevProjection& projection, int32_t point, int wanted,
+                                    int patch_radius) {
+  const Float3 centre = map.vertex(point);
+  const int cell = map.cell(point);
+  const int row = cell / projection.cols;
+  const int col = cell % projection.cols;
   detail::NearestPoints<GroundMap> nearest(map, centre, wanted);
   for (int ring = 0; ring <= patch_radius; ++ring) {
     const float ring_distance = static_cast<float>(ring - 1 > 0 ? ring - 1 : 0) * projection.cell_size;
@@ -182,70 +185,6 @@ ELO_HOST_DEVICE Float3 groundNormalAt(const GroundMap& map, const BevProjection&
     forEachPointOnRing(map, projection, row, col, ring, nearest);
   }
   return groundPlaneNormal(nearest.points, nearest.used, centre);
-}
-
-// The normal of model point `point` of `map`: groundNormalAt() its vertex and cell.
-template <typename GroundMap>
-ELO_HOST_DEVICE Float3 groundNormal(const GroundMap& map, const BevProjection& projection, int32_t point, int wanted,
-                                    int patch_radius) {
-  const int cell = map.cell(point);
-  return groundNormalAt(map, projection, map.vertex(point), cell / projection.cols, cell % projection.cols, wanted,
-                        patch_radius);
-}
-
-// The cells of a ground map within `radius` of (row, col), a square of side 2 radius + 1, copied out of
-// the map as a GroundMap of their own for groundNormalAt(), which reads them many times: copied first,
-// the loads of a GPU thread go out all at once instead of one chain per visited cell. Slot s of the
-// square (row-major) is at s * stride in each array, so that the threads of a warp can interleave their
-// patches in shared memory; the points of the patch are its slots.
-struct GroundPatch {
-  int first_row;
-  int first_col;
-  int side;
-  int grid_cols;
-  int stride;
-  uint8_t* occupied;
-  float* x;
-  float* y;
-  float* z;
-
-  ELO_HOST_DEVICE int slots() const { return side * side; }
-  ELO_HOST_DEVICE int32_t pointOfCell(int cell) const {  // cells of the square only
-    const int slot = (cell / grid_cols - first_row) * side + (cell % grid_cols - first_col);
-    return occupied[slot * stride] != 0 ? slot : -1;
-  }
-  ELO_HOST_DEVICE Float3 vertex(int32_t slot) const { return {x[slot * stride], y[slot * stride], z[slot * stride]}; }
-};
-
-// Fills `patch` (its place and side already set) from `map`, in batches of loads that do not wait for
-// one another: first the batch's cells, then their points' vertices.
-template <typename GroundMap>
-ELO_HOST_DEVICE void copyGroundPatch(const GroundMap& map, const BevProjection& projection, const GroundPatch& patch) {
-  constexpr int kBatch = 16;
-  const int slots = patch.slots();
-  for (int first = 0; first < slots; first += kBatch) {
-    int32_t points[kBatch];
-    Float3 vertices[kBatch];
-    ELO_UNROLL
-    for (int i = 0; i < kBatch; ++i) {
-      const int slot = first + i;
-      const int row = patch.first_row + slot / patch.side;
-      const int col = patch.first_col + slot % patch.side;
-      const bool inside = slot < slots && row >= 0 && row < projection.rows && col >= 0 && col < projection.cols;
-      points[i] = inside ? map.pointOfCell(row * projection.cols + col) : -1;
-    }
-    ELO_UNROLL
-    for (int i = 0; i < kBatch; ++i) vertices[i] = points[i] >= 0 ? map.vertex(points[i]) : Float3{0.0f, 0.0f, 0.0f};
-    ELO_UNROLL
-    for (int i = 0; i < kBatch; ++i) {
-      const int slot = first + i;
-      if (slot >= slots) break;
-      patch.occupied[slot * patch.stride] = points[i] >= 0 ? 1 : 0;
-      patch.x[slot * patch.stride] = vertices[i].x;
-      patch.y[slot * patch.stride] = vertices[i].y;
-      patch.z[slot * patch.stride] = vertices[i].z;
-    }
-  }
 }
 
 }  // namespace elo

@@ -214,33 +214,14 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
   }
 }
 
-// groundNormals: a warp per block, each thread's patch of the grid (radius up to kCopiedPatchRadius, the
-// default's) copied into its own column of shared memory (GroundPatch). Searched in place, the map cost
-// each thread a chain of dependent loads per visited cell, on a grid with few threads per SM.
-constexpr int kNormalThreads = 32;
-constexpr int kCopiedPatchRadius = 3;
-constexpr int kCopiedPatchSlots = (2 * kCopiedPatchRadius + 1) * (2 * kCopiedPatchRadius + 1);
-
-__global__ void __launch_bounds__(kNormalThreads)
-    groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius, Float3* normals) {
-  __shared__ uint8_t occupied[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float x[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float y[kCopiedPatchSlots][kNormalThreads];
-  __shared__ float z[kCopiedPatchSlots][kNormalThreads];
+// One thread per model point: its patch search (groundNormal()) stops after a ring or two, a chain of
+// dependent loads that the GPU hides only with many threads in flight (kWideGridBlocks). Copying each
+// thread's whole patch to shared memory first loaded every cell of it, and was slower.
+__global__ void groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius,
+                              Float3* normals) {
   const int count = *model.count;
-  const int lane = static_cast<int>(threadIdx.x);
   for (int point = globalThread(); point < count; point += gridThreads()) {
-    if (patch_radius > kCopiedPatchRadius) {
-      normals[point] = groundNormal(model, projection, point, wanted, patch_radius);
-      continue;
-    }
-    const int cell = model.cells[point];
-    const int row = cell / projection.cols;
-    const int col = cell % projection.cols;
-    const GroundPatch patch{row - patch_radius, col - patch_radius, 2 * patch_radius + 1, projection.cols,
-                            kNormalThreads, &occupied[0][lane], &x[0][lane], &y[0][lane], &z[0][lane]};
-    copyGroundPatch(model, projection, patch);
-    normals[point] = groundNormalAt(patch, projection, model.vertices[point], row, col, wanted, patch_radius);
+    normals[point] = groundNormal(model, projection, point, wanted, patch_radius);
   }
 }
 
@@ -257,7 +238,7 @@ void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const
                      const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
                      const CellCompaction& compaction, cudaStream_t stream) {
   const FusionSources sources{model, scan_ground, scan_from_model, fusion, 0, 0};
-  compact(sources, kGridStrideBlocks, projection, fusion.same_surface_distance, compaction, fused, stream);
+  compact(sources, kWideGridBlocks, projection, fusion.same_surface_distance, compaction, fused, stream);
 }
 
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream) {
@@ -275,9 +256,7 @@ void clearGroundMap(const DeviceBev& map, cudaStream_t stream) {
 
 void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
                       Float3* normals, cudaStream_t stream) {
-  // The same 65,536 threads as every grid-stride kernel, in blocks of one warp.
-  groundNormals<<<kGridStrideBlocks * kThreads / kNormalThreads, kNormalThreads, 0, stream>>>(
-      model, projection, wanted, patch_radius, normals);
+  groundNormals<<<kWideGridBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
   checkLaunch("groundNormals");
 }
 
