@@ -185,6 +185,9 @@ ScanRead readScan(const elo::Sequence& sequence, size_t index, size_t& non_finit
 
 class Report {
  public:
+  // `prefetching`: each scan went up to a device while the one before it was processed.
+  explicit Report(bool prefetching) : prefetching_(prefetching) {}
+
   // `upload_ms`: how long the frame waited for scans to reach a device (Backend::lastUploadMilliseconds();
   // 0 on the CPU backend).
   void add(const elo::FrameResult& result, double upload_ms) {
@@ -225,9 +228,9 @@ class Report {
     const double mean_total = summarise(total_).mean;
     const StageSummary upload = summarise(upload_);
     if (upload.mean > 0.0) {
-      std::printf("%-22s %10.3f %10.3f   (what the frames waited for; the rest of each upload ran beside the "
-                  "frame before)\n",
-                  "scan upload to GPU", upload.mean, upload.median);
+      std::printf("%-22s %10.3f %10.3f   (%s)\n", "scan upload to GPU", upload.mean, upload.median,
+                  prefetching_ ? "what the frames still waited for; the rest ran beside the frame before"
+                               : "part of the projection");
       std::printf("FPS without the upload: %.1f\n", 1000.0 / (mean_total - upload.mean));
     }
     rusage usage{};
@@ -240,6 +243,7 @@ class Report {
   }
 
  private:
+  bool prefetching_;
   std::vector<double> projection_, upload_, features_, registration_, model_update_, total_;
   std::map<std::string, size_t> unreadable_;
 };
@@ -280,7 +284,7 @@ void writeTrajectory(const Options& options, const elo::Sequence& sequence, cons
 class ScanLoop {
  public:
   ScanLoop(const Options& options, const elo::Sequence& sequence, elo::Odometry& odometry)
-      : options_(options), sequence_(sequence), odometry_(odometry) {
+      : options_(options), sequence_(sequence), odometry_(odometry), report_(options.prefetch) {
     if (options.timing_csv.empty()) return;
     timing_.open(options.timing_csv);
     if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
