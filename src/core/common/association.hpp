@@ -28,6 +28,14 @@ struct CorrespondenceGates {
   }
 };
 
+// Column `col` of an image `cols` wide that closes on itself in azimuth, for col in [-cols, 2 cols):
+// validate() keeps the association radius within half the image's width. A compare, not an integer
+// division (a modulo per searched pixel cost more than the rest of the search).
+ELO_HOST_DEVICE inline int wrappedColumn(int col, int cols) {
+  if (col < 0) return col + cols;
+  return col >= cols ? col - cols : col;
+}
+
 // Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
 // otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
 // within `radius` pixels; -1 when there is none.
@@ -40,8 +48,9 @@ ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3&
   const int first_row = row - radius < 0 ? 0 : row - radius;
   const int last_row = row + radius > model.rows - 1 ? model.rows - 1 : row + radius;
   for (int r = first_row; r <= last_row; ++r) {
+    const int row_start = r * model.cols;
     for (int dc = -radius; dc <= radius; ++dc) {
-      const int pixel = r * model.cols + (col + dc + model.cols) % model.cols;
+      const int pixel = row_start + wrappedColumn(col + dc, model.cols);
       if (!model.matchable(pixel)) continue;
       const float distance = squaredDistance(model.vertex(pixel), moved);
       if (distance < best_distance) {
@@ -68,19 +77,34 @@ ELO_HOST_DEVICE bool nongroundMatch(const SphericalProjection& projection, const
   return !(dot(motion.rotate(normal), model.normal(match)) < gates.min_normal_cosine);
 }
 
-// Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`.
+namespace detail {
+
+template <typename GroundMap, typename Visit>
+ELO_HOST_DEVICE void visitCell(const GroundMap& map, int cell, Visit& visit) {
+  const int32_t point = map.pointOfCell(cell);
+  if (point >= 0) visit(point);
+}
+
+}  // namespace detail
+
+// Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`,
+// row by row and, within a row, column by column.
 template <typename GroundMap, typename Visit>
 ELO_HOST_DEVICE void forEachPointOnRing(const GroundMap& map, const BevProjection& projection, int row, int col,
                                         int ring, Visit& visit) {
   const int first_row = row - ring < 0 ? 0 : row - ring;
   const int last_row = row + ring > projection.rows - 1 ? projection.rows - 1 : row + ring;
+  const int left = col - ring;  // the ring's two columns; either may lie outside the grid
+  const int right = col + ring;
+  const int first_col = left < 0 ? 0 : left;
+  const int last_col = right > projection.cols - 1 ? projection.cols - 1 : right;
   for (int r = first_row; r <= last_row; ++r) {
-    const bool edge_row = r == row - ring || r == row + ring;
-    const int step = edge_row || ring == 0 ? 1 : 2 * ring;  // inner rows: only the ring's two ends
-    for (int c = col - ring; c <= col + ring; c += step) {
-      if (c < 0 || c >= projection.cols) continue;
-      const int32_t point = map.pointOfCell(r * projection.cols + c);
-      if (point >= 0) visit(point);
+    const int row_start = r * projection.cols;
+    if (r == row - ring || r == row + ring) {  // the ring's top and bottom rows: every cell
+      for (int c = first_col; c <= last_col; ++c) detail::visitCell(map, row_start + c, visit);
+    } else {  // rows in between: only the ring's two ends
+      if (left >= 0) detail::visitCell(map, row_start + left, visit);
+      if (right < projection.cols) detail::visitCell(map, row_start + right, visit);
     }
   }
 }
@@ -144,7 +168,9 @@ struct NearestPoints {
 template <typename GroundMap>
 ELO_HOST_DEVICE int32_t nearestGroundPoint(const GroundMap& map, const BevProjection& projection, const Float3& point,
                                            int row, int col, int radius) {
-  for (int ring = 0; ring <= radius; ++ring) {
+  const int32_t in_cell = map.pointOfCell(row * projection.cols + col);  // ring 0: the one point it may hold
+  if (in_cell >= 0) return in_cell;
+  for (int ring = 1; ring <= radius; ++ring) {
     detail::NearestOnRing<GroundMap> nearest{map, point};
     forEachPointOnRing(map, projection, row, col, ring, nearest);
     if (nearest.best >= 0) return nearest.best;
