@@ -36,13 +36,12 @@ ELO_HOST_DEVICE inline int wrappedColumn(int col, int cols) {
   return col >= cols ? col - cols : col;
 }
 
-// Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
-// otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
-// within `radius` pixels; -1 when there is none.
+namespace detail {
+
+// The model pixel with a normal nearest to `moved` within `radius` pixels of (row, col); -1 when none.
 template <typename SphericalModel>
-ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3& moved, int row, int col, int radius) {
-  const int projected = row * model.cols + col;
-  if (model.matchable(projected)) return projected;
+ELO_HOST_DEVICE int nearestModelPixelAround(const SphericalModel& model, const Float3& moved, int row, int col,
+                                            int radius) {
   int best = -1;
   float best_distance = INFINITY;
   const int first_row = row - radius < 0 ? 0 : row - radius;
@@ -60,6 +59,19 @@ ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3&
     }
   }
   return best;
+}
+
+}  // namespace detail
+
+// Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
+// otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
+// within `radius` pixels; -1 when there is none. (The search is a function of its own so that the
+// common case, the projected pixel, stays inline in the caller's loop.)
+template <typename SphericalModel>
+ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3& moved, int row, int col, int radius) {
+  const int projected = row * model.cols + col;
+  if (model.matchable(projected)) return projected;
+  return detail::nearestModelPixelAround(model, moved, row, col, radius);
 }
 
 // The non-ground correspondence of scan vertex `vertex` (normal `normal`) under `motion`: the moved point
@@ -127,6 +139,19 @@ struct NearestOnRing {
   }
 };
 
+// The point of `map` nearest to `point` in the first ring of cells around (row, col), from ring 1 up to
+// `radius`, that holds any; -1 when none does.
+template <typename GroundMap>
+ELO_HOST_DEVICE int32_t nearestGroundPointOnRings(const GroundMap& map, const BevProjection& projection,
+                                                  const Float3& point, int row, int col, int radius) {
+  for (int ring = 1; ring <= radius; ++ring) {
+    NearestOnRing<GroundMap> nearest{map, point};
+    forEachPointOnRing(map, projection, row, col, ring, nearest);
+    if (nearest.best >= 0) return nearest.best;
+  }
+  return -1;
+}
+
 // Upper bound of bev.normal_neighbours (validate() enforces it), the size of the fit's fixed buffers.
 constexpr int kMaxNormalNeighbours = 32;
 
@@ -165,17 +190,14 @@ struct NearestPoints {
 
 // The point of `map` nearest to `point` in the cell of (row, col), or else in the first ring of cells
 // around it that holds any, up to `radius` rings out; -1 when there is none.
+// (The ring search is a function of its own so that the common case, a point in the cell itself, stays
+// inline in the caller's loop.)
 template <typename GroundMap>
 ELO_HOST_DEVICE int32_t nearestGroundPoint(const GroundMap& map, const BevProjection& projection, const Float3& point,
                                            int row, int col, int radius) {
   const int32_t in_cell = map.pointOfCell(row * projection.cols + col);  // ring 0: the one point it may hold
   if (in_cell >= 0) return in_cell;
-  for (int ring = 1; ring <= radius; ++ring) {
-    detail::NearestOnRing<GroundMap> nearest{map, point};
-    forEachPointOnRing(map, projection, row, col, ring, nearest);
-    if (nearest.best >= 0) return nearest.best;
-  }
-  return -1;
+  return detail::nearestGroundPointOnRings(map, projection, point, row, col, radius);
 }
 
 // The ground correspondence of scan ground vertex `vertex` under `motion` (Eq. 16): the model point in
