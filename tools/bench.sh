@@ -6,8 +6,8 @@
 #     machine shows less.
 #  2. The CPU backend, frame-to-frame, with 1 and 2 threads, on the same scans.
 #  3. Both backends on the same scans, the real ones and a simulated urban drive, frame-to-model, the CPU
-#     with all its threads. The CUDA runs also print the scan's upload to the GPU (part of the projection)
-#     and the FPS without it. Where the CUDA backend cannot run, they are left out, saying why.
+#     with all its threads. The CUDA runs also print what of the scans' upload to the GPU the frames
+#     waited for (elo_run prefetches each scan while the one before it runs) and the FPS without it. Where the CUDA backend cannot run, they are left out, saying why.
 # Usage:
 #   tools/bench.sh BUILD_DIR SHARED_DATA_DIR
 set -euo pipefail

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The CUDA backend's check, in one table: the CPU/CUDA agreement tests, compute-sanitizer's memcheck and
-# racecheck over a few real scans (deskew on, so that every kernel runs), and the CPU-against-GPU bench,
-# frame-to-model, over simulated drives of three sensors and the real scans.
+# racecheck over a few real scans (deskew on, so that every kernel runs), elo_run's poses with and without
+# the overlapped upload, and the CPU-against-GPU bench, frame-to-model, over simulated drives of three
+# sensors and the real scans.
 #
 # On a GPU machine with a full build:   tools/gpu_check.sh build/devel/lib/elo_odometry [SCANS_DIR]
 # From a kit packed by gpu_kit.sh:      bash .gpukit/setup.sh && source .gpukit/env.sh && tools/gpu_check.sh
@@ -76,6 +77,21 @@ bench_row() {
   echo "$cuda" >>"$work/bench.log"
 }
 
+# elo_run on CUDA over INPUT with the next scan's upload overlapping each scan (the default) and
+# without (--no-prefetch): the poses must be identical; the row gives the upload each run waited for.
+check_prefetch() {
+  local name=$1 input=$2 with without
+  with=$("$bin/elo_run" --input "$input" --output "$work/prefetched.txt" --quiet --backend cuda 2>&1) &&
+    without=$("$bin/elo_run" --input "$input" --output "$work/unprefetched.txt" --quiet --backend cuda \
+      --no-prefetch 2>&1) || { fail "prefetched uploads, $name" "elo_run failed"; return; }
+  if ! cmp -s "$work/prefetched.txt" "$work/unprefetched.txt"; then
+    fail "prefetched uploads, $name" "poses differ from --no-prefetch"
+    return
+  fi
+  row "prefetched uploads, $name" "poses identical; upload waited $(awk '/^scan upload to GPU/ {print $5}' \
+    <<<"$with") ms a scan, $(awk '/^scan upload to GPU/ {print $5}' <<<"$without") ms with --no-prefetch"
+}
+
 simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
   local sensor=$1 world=$2 trajectory=$3 dir=$4
   shift 4
@@ -102,6 +118,7 @@ bench_row "HDL-64E distorted, deskew azimuth" "$work/hdl64_distorted" "$(mean_po
 bench_row "VLP-16, urban, $frames scans" "$work/vlp16" "$(mean_points "$work/vlp16")"
 bench_row "OS1-128, urban, $frames scans" "$work/os1_128" "$(mean_points "$work/os1_128")"
 [ -d "$scans" ] && bench_row "real HDL-64E, $(ls "$scans" | wc -l) scans" "$scans" "-"
+check_prefetch "HDL-64E, urban, $frames scans" "$work/hdl64"
 
 echo
 printf '%-44s %s\n' "check" "result"
@@ -110,6 +127,7 @@ echo
 printf '%-34s %8s %9s %9s %10s %10s %9s\n' "bench, f2m" "points" "CPU FPS" "CUDA FPS" "ms/scan" \
   "w/o upload" "upload ms"
 printf '%s\n' "${bench[@]}"
-echo "(CPU: all $(nproc) threads. CUDA FPS and ms/scan include the scan's upload; 'w/o upload' is the FPS without it.)"
+echo "(CPU: all $(nproc) threads. CUDA FPS and ms/scan include the scan's upload; 'upload ms' is what of it the"
+echo " frames still waited for, elo_run prefetching each scan while the one before it runs; 'w/o upload' leaves that out.)"
 [ -n "${GPU_CHECK_LOG:-}" ] && cp "$work"/*.log "$GPU_CHECK_LOG"/ 2>/dev/null
 exit $((failures > 0))

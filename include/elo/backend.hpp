@@ -80,7 +80,19 @@ class Backend {
 
   // Waits until every stage called so far has finished, so that its time can be taken.
   virtual void synchronize() {}
-  // Of the last projectScan(), the time (ms) spent moving the cloud to the device; 0 on the host.
+
+  // Starts moving `cloud`, a scan to project after the current one, to the device while the current
+  // scan's stages run (docs/cuda.md); nothing to do on the host. projectScan() takes that upload only for
+  // the same cloud (CloudIdentity: the same arrays' memory, lengths and stamp), and its results are the
+  // same, bit for bit, with or without it. The cloud's arrays are read until finishPrefetch() returns, and
+  // must not change until the cloud is projected.
+  virtual void prefetch(const PointCloud& /*cloud*/) {}
+  // Waits until the backend no longer reads the arrays of the cloud last prefetched. Never throws: a
+  // failed upload is reported by the projectScan() of its cloud.
+  virtual void finishPrefetch() noexcept {}
+  // Of the last scan, the time (ms) its processing waited for scans to reach the device: in projectScan(),
+  // for its own upload (all of it unless prefetched), and in finishPrefetch(), for the next scan's
+  // arrays to be read; 0 on the host.
   virtual double lastUploadMilliseconds() const { return 0.0; }
 };
 

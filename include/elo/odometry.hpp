@@ -52,8 +52,17 @@ class Odometry {
   // Processes one sweep. A scan that cannot be used (empty, too few valid points, a stamp that is not
   // finite or repeats the last one to the nanosecond) is skipped, counted under its reason and leaves the state as it was.
   // A stamp before the last one resets (see reset()); one more than model.time_window after it restarts
-  // the model at the current pose (FrameResult::gap_restart).
+  // the model at the current pose (FrameResult::gap_restart). It returns, normally or by an exception,
+  // only once the backend no longer reads a cloud handed to prefetch().
   FrameResult process(const PointCloud& cloud);
+
+  // Hands over the scan a later process() call will be given, normally the call after the next one, so
+  // that a device backend uploads it while the next call processes its scan (Backend::prefetch(),
+  // docs/cuda.md). Only a speed-up: process() gives the same results, bit for bit, whatever was
+  // prefetched, and takes the upload for the same cloud only (the same arrays' memory and lengths, and the
+  // same stamp; a cloud moved to another PointCloud is the same). `cloud` must stay alive until the next
+  // process() call returns, and must not change until it is processed.
+  void prefetch(const PointCloud& cloud) { backend_->prefetch(cloud); }
 
   // Forgets the model, the motion and the pose: the next scan starts a new trajectory at identity.
   void reset();
@@ -85,6 +94,8 @@ class Odometry {
   size_t minOccupiedPixels() const;
 
  private:
+  // process() but for the total time and the end of the prefetch.
+  FrameResult processScan(const PointCloud& cloud);
   FrameResult skip(const std::string& reason);
   // Forgets the model and the motion but keeps the pose: the next scan continues the trajectory from it.
   void restartModel();

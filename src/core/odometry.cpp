@@ -93,6 +93,21 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, 
 }
 
 FrameResult Odometry::process(const PointCloud& cloud) {
+  const auto start = Clock::now();
+  FrameResult result;
+  try {
+    result = processScan(cloud);
+  } catch (...) {
+    backend_->finishPrefetch();  // the caller may free the prefetched cloud once this returns
+    throw;
+  }
+  // Normally staged long before; a wait here is the pipeline's, and counts in its time.
+  backend_->finishPrefetch();
+  if (result.processed) result.times.total = millisecondsSince(start);
+  return result;
+}
+
+FrameResult Odometry::processScan(const PointCloud& cloud) {
   if (cloud.points.empty()) return skip("empty cloud");
   if (!std::isfinite(cloud.stamp)) return skip("stamp not finite");
   if (started_ && secondsSinceFirst(cloud.stamp) == last_since_first_) return skip("duplicate stamp");
@@ -101,7 +116,6 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   if (!started_) first_stamp_ = cloud.stamp;
   const double since_first = secondsSinceFirst(cloud.stamp);
 
-  const auto frame_start = Clock::now();
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
   const float relative_stamp = static_cast<float>(since_first);
   const CloudTimes times = inspectTimes(cloud, config_);
@@ -172,7 +186,6 @@ FrameResult Odometry::process(const PointCloud& cloud) {
   ++processed_;
   result.processed = true;
   result.pose = pose_;
-  result.times.total = millisecondsSince(frame_start);
   return result;
 }
 

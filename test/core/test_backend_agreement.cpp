@@ -1,7 +1,8 @@
 // The CUDA backend against the CPU backend on the same inputs, stage by stage: range images, point
 // indices, ground labels and BEV maps identical; normals within 1e-4; Gauss-Newton sums within 1e-6
-// (relative); poses within 1e-4 m and 1e-4 rad at every frame. These tests skip, saying why, where no
-// CUDA device is usable or the build has no CUDA backend. The factory tests run everywhere.
+// (relative), and the GPU's the same bit for bit when linearised again; poses within 1e-4 m and 1e-4
+// rad at every frame. These tests skip, saying why, where no CUDA device is usable or the build has no
+// CUDA backend. The factory tests run everywhere.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -132,6 +133,15 @@ void expectAgreeingSums(const TermSums& cpu, const TermSums& cuda) {
   EXPECT_LE(std::abs(cpu.squared_error - cuda.squared_error), kRelative * cpu.squared_error);
 }
 
+// The same linearisation twice on one GPU: the same sums bit for bit, whichever block finished last.
+void expectIdenticalSums(const TermSums& first, const TermSums& again) {
+  EXPECT_EQ(first.candidates, again.candidates);
+  EXPECT_EQ(first.inliers, again.inliers);
+  EXPECT_EQ(first.JtJ, again.JtJ);
+  EXPECT_EQ(first.Jte, again.Jte);
+  EXPECT_EQ(first.squared_error, again.squared_error);
+}
+
 void expectAgreeingPoses(const Eigen::Isometry3d& cpu, const Eigen::Isometry3d& cuda, size_t frame) {
   EXPECT_LT((cpu.translation() - cuda.translation()).norm(), kPoseTolerance) << "frame " << frame;
   EXPECT_LT(rotationAngle(cpu.inverse() * cuda), kPoseTolerance) << "frame " << frame;
@@ -185,6 +195,27 @@ TEST(BackendAgreement, NormalsAgreeForEveryMethod) {
       backends.prepare(streetScan(config, Eigen::Isometry3d::Identity(), 0.0, noise), 0.0f);
       expectAgreeingNormals(backends.cpu->scan().image, backends.cuda->scan().image);
     }
+  }
+}
+
+// The GPU reads each window from its block's tile in shared memory: windows too large for a block's tile
+// stop the CUDA backend with an error that names the parameters to change.
+TEST(BackendAgreement, WindowsTooLargeForATileStopTheCudaBackendNamingTheParameters) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.normals.max_window_width = 81;
+  config.normals.max_window_height = 41;
+  config.runtime.backend = BackendKind::cuda;
+  const std::unique_ptr<Backend> backend = makeBackend(config);
+  backend->projectScan(streetScan(config), 0.0f);
+  backend->segmentGround();
+  try {
+    backend->estimateNormals();
+    ADD_FAILURE() << "81 x 41 windows need 86,016 bytes of shared memory per block, and ran";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("normals.max_window_width x normals.max_window_height"),
+              std::string::npos)
+        << error.what();
   }
 }
 
@@ -246,6 +277,9 @@ TEST(BackendAgreement, GaussNewtonSumsAgreeForEveryCostVariant) {
         const NormalEquations cuda = backends.cuda->linearize(guess, kernel_scale);
         expectAgreeingSums(cpu.nonground, cuda.nonground);
         expectAgreeingSums(cpu.ground, cuda.ground);
+        const NormalEquations again = backends.cuda->linearize(guess, kernel_scale);
+        expectIdenticalSums(cuda.nonground, again.nonground);
+        expectIdenticalSums(cuda.ground, again.ground);
       }
     }
   }
@@ -364,6 +398,85 @@ TEST(BackendAgreement, GpuRunsAreReproducible) {
     const PointCloud cloud = streetScan(config, truth, 0.1 * frame, 0.02);
     EXPECT_EQ(first.process(cloud).pose.matrix(), second.process(cloud).pose.matrix()) << "frame " << frame;
     truth = truth * pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
+  }
+}
+
+// Sweeps down the street at 10 m/s while turning: points with rings and per-point times.
+PointCloud streetSweep(const Config& config, int frame) {
+  Vector6d velocity;
+  velocity << 10.0, 0.0, 0.0, 0.0, 0.0, 0.12;
+  const Eigen::Isometry3d truth = pose(-25, 0, 0, 0, 0, 0) * expSE3(0.1 * frame * velocity);
+  return test::sweepScene(test::streetScene(), config.sensor, truth, velocity, 0.1 * frame).cloud;
+}
+
+// A prefetched upload (Backend::prefetch()) is taken for its own cloud only, and projects as the same
+// cloud uploaded by the projection: another cloud projected in between, clouds prefetched one, two and
+// three ahead (the first two then dropped), the same cloud twice, a cloud prefetched without the times
+// its projection deskews by (deskew.time_source azimuth), and a scan with fewer points than the last.
+TEST(BackendAgreement, ProjectionTakesAPrefetchedUploadOnlyForItsCloud) {
+  ELO_REQUIRE_CUDA();
+  for (const TimeSource prefetched_times : {TimeSource::field, TimeSource::azimuth}) {
+    SCOPED_TRACE(prefetched_times == TimeSource::field ? "times prefetched" : "times not prefetched");
+    Config config;
+    config.runtime.backend = BackendKind::cuda;
+    config.deskew.time_source = prefetched_times;
+    std::vector<PointCloud> clouds;
+    for (int frame = 0; frame < 4; ++frame) clouds.push_back(streetSweep(config, frame));
+    clouds[3].points.resize(clouds[3].size() / 2);
+    clouds[3].ring.resize(clouds[3].size());
+    clouds[3].time.resize(clouds[3].size());
+    Vector6d velocity;
+    velocity << 9.0, 0.0, 0.0, 0.0, 0.0, 0.1;
+    const std::unique_ptr<Backend> plain = makeBackend(config);
+    const std::unique_ptr<Backend> prefetching = makeBackend(config);
+    const auto expectSameScan = [&](const PointCloud& cloud, const std::string& what) {
+      SCOPED_TRACE(what);
+      const SweepMotion motion{TimeSource::field, velocity, 0.0};
+      const float stamp = static_cast<float>(cloud.stamp);
+      EXPECT_EQ(plain->projectScan(cloud, stamp, motion), prefetching->projectScan(cloud, stamp, motion));
+      expectSameProjection(plain->scan(), prefetching->scan());
+      EXPECT_EQ(plain->scan().time, prefetching->scan().time);
+      EXPECT_EQ(plain->scan().measured, prefetching->scan().measured);
+    };
+    prefetching->prefetch(clouds[0]);
+    expectSameScan(clouds[1], "another cloud than the one prefetched");
+    expectSameScan(clouds[0], "the cloud prefetched before another was projected");
+    for (int ahead = 1; ahead < 4; ++ahead) prefetching->prefetch(clouds[ahead]);
+    for (int ahead = 1; ahead < 4; ++ahead) expectSameScan(clouds[ahead], "prefetched " + std::to_string(ahead) + " ahead");
+    prefetching->prefetch(clouds[2]);
+    prefetching->prefetch(clouds[2]);
+    expectSameScan(clouds[2], "prefetched twice");
+    expectSameScan(clouds[2], "projected again, from its second prefetched upload");
+    prefetching->finishPrefetch();
+  }
+}
+
+// elo_run's order: each scan prefetched before the scan before it is processed, then moved to where it
+// is processed from; and a prefetched scan the odometry skips (a repeated stamp).
+TEST(BackendAgreement, PrefetchedScansGiveTheSamePosesBitForBit) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.runtime.backend = BackendKind::cuda;
+  Odometry plain(config);
+  Odometry prefetching(config);
+  constexpr int kFrames = 8;
+  PointCloud next = streetSweep(config, 0);
+  prefetching.prefetch(next);
+  for (int frame = 0; frame < kFrames; ++frame) {
+    const PointCloud current = std::move(next);
+    if (frame + 1 < kFrames) {
+      next = streetSweep(config, frame + 1);
+      prefetching.prefetch(next);
+    }
+    const FrameResult a = plain.process(current);
+    const FrameResult b = prefetching.process(current);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    EXPECT_EQ(a.deskew_rounds, b.deskew_rounds) << "frame " << frame;
+    EXPECT_EQ(a.pose.matrix(), b.pose.matrix()) << "frame " << frame;
+    const PointCloud repeated = current;
+    prefetching.prefetch(repeated);
+    EXPECT_EQ(prefetching.process(repeated).skip_reason, "duplicate stamp") << "frame " << frame;
+    if (frame + 1 < kFrames) prefetching.prefetch(next);
   }
 }
 

@@ -1,7 +1,8 @@
 // The per-element math both backends run (src/core/common), tested on the CPU. The CPU backend calls
 // most of it, so the stage tests cover it too; these tests cover what is new or only the CUDA backend
-// runs: the ported eigen-solver, the keys, transforms and point-to-plane terms, and windowNormal(), the
-// scalar normal estimator of the GPU, against the CPU backend's vectorised one.
+// runs: the ported eigen-solver, the keys, transforms and point-to-plane terms, windowNormal(), the
+// scalar normal estimator of the GPU, against the CPU backend's vectorised one, the GPU's tiles of the scan
+// it reads its windows from, and the GPU's per-pixel ground labels against the CPU's column walk.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,9 +11,12 @@
 #include "analytic_scene.hpp"
 #include "core/common/closest_wins_key.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/common/ground.hpp"
 #include "core/common/normals.hpp"
 #include "core/common/point_to_plane.hpp"
 #include "core/cpu/image_views.hpp"
+#include "core/cpu/packed_sums.hpp"
+#include "core/cuda/normal_tile.hpp"
 #include "elo/backend.hpp"
 
 namespace elo {
@@ -162,6 +166,31 @@ TEST(PointToPlane, ResidualJacobianAndGemanMcClureWeight) {
   EXPECT_DOUBLE_EQ(gemanMcClureWeight(0.1, 0.1), 0.25);  // (s^2 / (s^2 + e^2))^2 at e = s
 }
 
+// The CPU's 4-wide accumulator adds each packed value the same products in the same order as the shared
+// scalar one, so its sums are the same bit for bit.
+TEST(PackedSums, TheCpusLaneSumsEqualTheSharedScalarSumsBitForBit) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f);
+  std::uniform_real_distribution<float> offset(-0.2f, 0.2f);
+  double scalar[kTermValues] = {};
+  cpu::LaneSums lanes;
+  for (int i = 0; i < 1000; ++i) {
+    const Float3 moved{coordinate(random), coordinate(random), coordinate(random)};
+    const Float3 vertex = moved + Float3{offset(random), offset(random), offset(random)};
+    const Float3 tilted{offset(random), offset(random), 1.0f};
+    const Float3 normal = tilted / norm(tilted);
+    const PointToPlane term = pointToPlane(moved, vertex, normal, 0.1);
+    addToPackedSums(term, scalar);
+    lanes.add(term);
+  }
+  double from_lanes[kTermValues];
+  lanes.copyTo(from_lanes);
+  for (int v = 0; v < kTermValues; ++v) {
+    EXPECT_NE(scalar[v], 0.0) << "value " << v;
+    EXPECT_EQ(from_lanes[v], scalar[v]) << "value " << v;
+  }
+}
+
 // Normals of the CPU backend's and of windowNormal() / crossProductNormal() over the same scan.
 struct NormalComparison {
   size_t cpu_normals = 0;
@@ -210,6 +239,155 @@ TEST(SharedNormalEstimator, TheGpusScalarEstimatorGivesTheCpuBackendsNormalsBitF
       EXPECT_EQ(comparison.largest_difference, 0.0f);
     }
   }
+}
+
+// Each pixel's normal from its block's tile (normal_tile.hpp), as the CUDA backend's blocks of
+// `block_rows` x `block_cols` pixels read it, against pixelNormal() over the whole scan.
+struct TileComparison {
+  size_t normals = 0;     // pixels with a normal over the whole scan
+  size_t differing = 0;   // pixels whose normal from the tile differs in any bit
+  size_t misplaced = 0;   // slots whose pixel the tile looks up elsewhere, in a slot holding another pixel
+};
+
+TileComparison compareTilesWithWholeScan(const Config& config, int block_rows, int block_cols) {
+  const test::ScanWithTruth truth =
+      test::scanScene(test::streetScene(), config.sensor, Eigen::Isometry3d::Identity(), 0.0, 0.02);
+  std::unique_ptr<Backend> backend = makeBackend(config);
+  backend->projectScan(truth.cloud, 0.0f);
+  backend->segmentGround();
+  const ScanImage& scan = backend->scan();
+  const cpu::ScanPixels pixels(scan);
+  const NormalParams params = NormalParams::fromConfig(config.normals, SphericalProjection::fromConfig(config.sensor));
+  TileComparison comparison;
+  for (int block_row = 0; block_row < pixels.rows; block_row += block_rows) {
+    for (int block_col = 0; block_col < pixels.cols; block_col += block_cols) {
+      const cuda::TileShape shape = cuda::TileShape::around(params, block_row, block_col, block_rows, block_cols);
+      std::vector<cuda::TilePixel> tile(shape.slots());
+      for (int slot = 0; slot < shape.slots(); ++slot) {
+        tile[slot] = cuda::loadTilePixel(pixels, shape, slot);
+        const int pixel = shape.pixelOfSlot(slot);
+        if (pixel < 0) continue;
+        const int found = shape.slotOfPixel(pixel);
+        comparison.misplaced += found < 0 || found >= shape.slots() || shape.pixelOfSlot(found) != pixel;
+      }
+      const cuda::TileImage image{pixels.rows, pixels.cols, shape, tile.data(), scan.image.range.data()};
+      for (int row = block_row; row < std::min(block_row + block_rows, pixels.rows); ++row) {
+        for (int col = block_col; col < std::min(block_col + block_cols, pixels.cols); ++col) {
+          if (!pixels.usable(row * pixels.cols + col)) continue;
+          const Float3 whole = pixelNormal(pixels, row, col, params);
+          const Float3 tiled = pixelNormal(image, row, col, params);
+          comparison.normals += !isZero(whole);
+          comparison.differing += std::memcmp(&whole, &tiled, sizeof(Float3)) != 0;
+        }
+      }
+    }
+  }
+  return comparison;
+}
+
+// The tiles hold every pixel the windows reach, wrapping around the image's ends as the windows do: the
+// kernel's 8 x 32 blocks, and on the narrower images odd shapes that end inside the image too; images
+// narrower than one tile with its halo (some columns in it twice) and wider ones whose width no block
+// shape divides.
+TEST(NormalTile, NormalsFromTheTilesAreThoseFromTheWholeScanBitForBit) {
+  for (const NormalMethod method : {NormalMethod::range_adaptive, NormalMethod::eigen, NormalMethod::cross_product}) {
+    for (const int width : {2048, 1000, 24}) {
+      Config config;
+      config.normals.method = method;
+      config.sensor.image_width = width;
+      config.runtime.threads = 2;
+      for (const auto& [block_rows, block_cols] : {std::pair{8, 32}, std::pair{3, 7}}) {
+        if (width == 2048 && block_cols != 32) continue;  // the full image only as the kernel tiles it: time
+        SCOPED_TRACE("method " + std::to_string(static_cast<int>(method)) + ", width " + std::to_string(width) +
+                     ", blocks " + std::to_string(block_rows) + " x " + std::to_string(block_cols));
+        const TileComparison comparison = compareTilesWithWholeScan(config, block_rows, block_cols);
+        EXPECT_GT(comparison.normals, width == 2048 ? 10000u : 10u);
+        EXPECT_EQ(comparison.differing, 0u);
+        EXPECT_EQ(comparison.misplaced, 0u);
+      }
+    }
+  }
+}
+
+// One column of a range image, as ground.hpp's Image.
+struct ColumnImage {
+  int rows;
+  int cols = 1;
+  std::vector<bool> occupied_rows{};
+  std::vector<Float3> vertices{};
+  mutable std::vector<PixelLabel> labels{};
+
+  bool occupied(int pixel) const { return occupied_rows[pixel]; }
+  Float3 vertex(int pixel) const { return vertices[pixel]; }
+  void setLabel(int pixel, PixelLabel label) const { labels[pixel] = label; }
+
+  std::vector<uint32_t> bits() const {
+    std::vector<uint32_t> words((rows + 31) / 32, 0u);
+    for (int row = 0; row < rows; ++row) words[row / 32] |= occupied_rows[row] ? 1u << (row % 32) : 0u;
+    return words;
+  }
+};
+
+TEST(ColumnBits, NameTheNearestOccupiedRowsAcrossWords) {
+  ColumnImage column{80};
+  column.occupied_rows.assign(80, false);
+  for (const int row : {0, 31, 32, 63, 79}) column.occupied_rows[row] = true;
+  const std::vector<uint32_t> words = column.bits();
+  const ColumnBits bits{words.data(), 1, static_cast<int>(words.size())};
+  EXPECT_EQ(occupiedRowAbove(bits, 0), -1);
+  EXPECT_EQ(occupiedRowBelow(bits, 0), 31);
+  EXPECT_EQ(occupiedRowAbove(bits, 31), 0);
+  EXPECT_EQ(occupiedRowBelow(bits, 31), 32);
+  EXPECT_EQ(occupiedRowAbove(bits, 32), 31);
+  EXPECT_EQ(occupiedRowBelow(bits, 32), 63);
+  EXPECT_EQ(occupiedRowAbove(bits, 50), 32);  // an empty row names its neighbours too
+  EXPECT_EQ(occupiedRowBelow(bits, 63), 79);
+  EXPECT_EQ(occupiedRowAbove(bits, 79), 63);
+  EXPECT_EQ(occupiedRowBelow(bits, 79), -1);
+  EXPECT_TRUE(bits.occupied(63));
+  EXPECT_FALSE(bits.occupied(64));
+  const std::vector<uint32_t> none(3, 0u);
+  const ColumnBits empty{none.data(), 1, 3};
+  EXPECT_EQ(occupiedRowAbove(empty, 70), -1);
+  EXPECT_EQ(occupiedRowBelow(empty, 5), -1);
+}
+
+// The GPU labels each pixel from its column's bits (pixelGroundLabel()); the CPU walks the column
+// (segmentColumn()). Random columns of road and obstacles, of every fill, as tall as one word, less, and
+// more: the same labels, the unoccupied pixels left alone.
+TEST(ColumnBits, PerPixelGroundLabelsAreThoseOfTheColumnWalk) {
+  const GroundBand band = GroundBand::fromConfig(GroundConfig());
+  std::mt19937 random(11);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  size_t ground = 0;
+  size_t nonground = 0;
+  for (const int rows : {1, 2, 31, 32, 33, 64, 80, 130}) {
+    for (const float fill : {0.0f, 0.1f, 0.5f, 0.9f, 1.0f}) {
+      for (int trial = 0; trial < 20; ++trial) {
+        ColumnImage column{rows};
+        for (int row = 0; row < rows; ++row) {
+          column.occupied_rows.push_back(unit(random) < fill);
+          // Rings reach the road farther out the higher they are; a fifth of the points lie on obstacles.
+          const float distance = 4.0f + 0.5f * static_cast<float>(rows - row);
+          const float height = unit(random) < 0.2f ? 2.0f * unit(random) - 1.0f : 0.03f * unit(random);
+          column.vertices.push_back({distance, 0.0f, static_cast<float>(-GroundConfig().sensor_height) + height});
+        }
+        column.labels.assign(rows, PixelLabel::empty);
+        ColumnImage walked = column;
+        segmentColumn(walked, 0, band);
+        const std::vector<uint32_t> words = column.bits();
+        const ColumnBits bits{words.data(), 1, static_cast<int>(words.size())};
+        for (int row = 0; row < rows; ++row) {
+          if (bits.occupied(row)) column.setLabel(row, pixelGroundLabel(column, bits, row, 0, band));
+        }
+        ASSERT_EQ(column.labels, walked.labels) << rows << " rows, fill " << fill << ", trial " << trial;
+        ground += std::count(walked.labels.begin(), walked.labels.end(), PixelLabel::ground);
+        nonground += std::count(walked.labels.begin(), walked.labels.end(), PixelLabel::nonground);
+      }
+    }
+  }
+  EXPECT_GT(ground, 1000u);
+  EXPECT_GT(nonground, 1000u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // elo_run over a simulated sequence with scans it cannot read: a truncated or malformed scan is skipped,
 // counted by reason and its pose line repeats the last pose, so that the lines still match the scans;
 // --strict stops at such a scan with a non-zero exit, after writing the poses of the scans before it.
+// --no-prefetch changes no pose.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -165,6 +166,19 @@ TEST_F(EloRunCli, StrictRunOverGoodScansSucceeds) {
   const CommandResult result = runEloRun("--strict");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(lines(poses()), intact_poses_);
+}
+
+// On the CUDA backend, where one is usable, the next scan's upload overlaps this scan's processing
+// unless --no-prefetch; it changes no pose. Elsewhere both runs fall back to the CPU backend.
+TEST_F(EloRunCli, PrefetchingChangesNoPose) {
+  const std::string cuda = "--backend cuda --set runtime.backend_fallback=true ";
+  const CommandResult prefetched = runEloRunOn(sequence_.string(), directory_.file("prefetched.txt"), cuda);
+  ASSERT_EQ(prefetched.exit_code, 0) << prefetched.output;
+  const CommandResult unprefetched = runEloRunOn(sequence_.string(), poses(), cuda + "--no-prefetch");
+  ASSERT_EQ(unprefetched.exit_code, 0) << unprefetched.output;
+  const std::vector<std::string> written = lines(poses());
+  EXPECT_EQ(written.size(), kScans);
+  EXPECT_EQ(lines(directory_.file("prefetched.txt")), written);
 }
 
 }  // namespace

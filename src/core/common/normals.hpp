@@ -1,8 +1,9 @@
 // Sec. III-B.3-4, Eq. 10-12: the normal of one pixel of the non-ground range image, by the range-adaptive
-// estimator or the Table III baselines. The CUDA backend runs pixelNormal() once per pixel. The CPU
-// backend gathers the windows with vectorised masked sums instead (normal_estimation.cpp) and shares the
-// rest; gatherWindow() adds in the order and with the roundings of those sums, so both backends get the
-// same normals bit for bit, which a CPU test checks.
+// estimator or the Table III baselines. The CUDA backend runs pixelNormal() once per pixel, on a tile of
+// the scan in shared memory (cuda/normal_tile.hpp). The CPU backend gathers the windows with vectorised
+// masked sums instead (normal_estimation.cpp) and shares the rest; gatherWindow() adds in the order and
+// with the roundings of those sums, so both backends get the same normals bit for bit, which a CPU test
+// checks.
 //
 // An Image provides `rows`, `cols`, `bool usable(int pixel)` (a non-ground pixel), `Float3 vertex(int
 // pixel)` and `float range(int pixel)`.
@@ -81,7 +82,13 @@ ELO_HOST_DEVICE inline Float3 towardsSensor(const Float3& normal, const Float3& 
   return dot(normal, point) > 0.0f ? -normal : normal;
 }
 
-ELO_HOST_DEVICE inline int wrapColumn(int col, int cols) { return (col % cols + cols) % cols; }  // azimuth is circular
+// Azimuth is circular. A window reaches less than a turn past either end, where one addition wraps; the
+// remainders (slow on a GPU) serve the rest.
+ELO_HOST_DEVICE inline int wrapColumn(int col, int cols) {
+  if (col >= cols) return col - cols < cols ? col - cols : col % cols;
+  if (col < 0) return col >= -cols ? col + cols : (col % cols + cols) % cols;
+  return col;
+}
 
 // The arithmetic of one neighbour at offset (dx, dy, dz) from the window's centre, which the CPU
 // backend's vectorised lanes and gatherWindow() both call.
@@ -92,6 +99,50 @@ ELO_HOST_DEVICE inline float windowPlaneOffset(float dx, float dy, float dz, flo
   return fusedMultiplyAdd(dz, nz, fusedMultiplyAdd(dy, ny, dx * nx));
 }
 
+// The CPU backend adds its 16 lanes pairwise: lane i += lane i + 8, then + 4, + 2, + 1. That is a balanced
+// binary tree whose leaves, left to right, are the lanes in bit-reversed order (0, 8, 4, 12, 2, 10, ...).
+// Adding each lane into the tree as soon as it is summed, taking the lanes in that order, forms the same
+// additions of the same operands, while holding one pending subtree per level rather than all 16 lanes:
+// a GPU thread keeps them in registers instead of spilling 16 lanes of sums to local memory.
+template <int kValues>
+class LaneTree {
+ public:
+  static constexpr int kLevels = 4;
+  static_assert(kWindowLanes == 1 << kLevels, "the tree has one leaf per lane");
+
+  // The lane that is leaf `leaf` of the tree.
+  ELO_HOST_DEVICE static int laneOfLeaf(int leaf) {
+    return ((leaf & 1) << 3) | ((leaf & 2) << 1) | ((leaf & 4) >> 1) | ((leaf & 8) >> 3);
+  }
+
+  // Adds the sums of leaf `leaf`; leaves come in order, from 0. After the last, `values` holds the total.
+  ELO_HOST_DEVICE void add(int leaf, float (&values)[kValues]) { addAtLevel<0>(leaf, values); }
+
+ private:
+  // A level per instantiation, so that every index into pending_ is a constant and the GPU keeps it in
+  // registers.
+  template <int kLevel>
+  ELO_HOST_DEVICE void addAtLevel(int leaf, float (&values)[kValues]) {
+    if (((leaf >> kLevel) & 1) == 0) {  // a left subtree: it waits for its right sibling
+      for (int q = 0; q < kValues; ++q) pending_[kLevel][q] = values[q];
+      return;
+    }
+    for (int q = 0; q < kValues; ++q) values[q] = pending_[kLevel][q] + values[q];
+    if constexpr (kLevel + 1 < kLevels) addAtLevel<kLevel + 1>(leaf, values);
+  }
+
+  float pending_[kLevels][kValues] = {};  // each read follows its write; GCC cannot tell
+};
+
+// Whether lane `lane` holds any column offset of a window of half-width `half_width` (see gatherWindow()).
+ELO_HOST_DEVICE inline bool laneInWindow(int lane, int half_width, const NormalParams& params) {
+  for (int segment = 0; segment < params.window_span; segment += kWindowLanes) {
+    const int offset = segment + lane - params.window_span / 2;
+    if (offset >= -half_width && offset <= half_width) return true;
+  }
+  return false;
+}
+
 // Accumulates the window's non-ground pixels (the centre included) as offsets from the centre. With
 // `reject_distant`, test 1 of the paper: neighbours farther than sigma_r are left out, and when they are
 // more than half of all the centre is an outlier and gets no normal (returns false). With a `plane`
@@ -99,8 +150,8 @@ ELO_HOST_DEVICE inline float windowPlaneOffset(float dx, float dy, float dz, flo
 //
 // The sums are formed as the CPU backend forms them: lane L of a window row holds the column offsets
 // L - span/2 (+ 16, + 32 ... for wider windows), each lane sums over the rows from the top, and the 16
-// lanes are then added pairwise (lane i += lane i + 8, + 4, + 2, + 1). Lanes outside the window add only
-// zeros there, which change no sum, so they are skipped here.
+// lanes are then added pairwise (LaneTree). Lanes outside the window add only zeros there, which change
+// no sum, so they are skipped here.
 template <typename Image>
 ELO_HOST_DEVICE bool gatherWindow(const Image& image, int row, int col, int half_width, int half_height,
                                   bool reject_distant, const Float3* plane, const NormalParams& params,
@@ -111,13 +162,15 @@ ELO_HOST_DEVICE bool gatherWindow(const Image& image, int row, int col, int half
   const int first_row = row - half_height < 0 ? 0 : row - half_height;
   const int last_row = row + half_height > image.rows - 1 ? image.rows - 1 : row + half_height;
   const int pad = params.window_span / 2;
-  float lanes[kWindowLanes][kSums] = {};
+  LaneTree<kSums> lanes;
+  float sums[kSums];  // the lane's sums, then the total
   int neighbours = 0;
   int distant = 0;
   int kept = 0;
-  for (int lane = 0; lane < kWindowLanes; ++lane) {
-    float sums[kSums] = {};  // the lane's sums, kept in registers on the GPU while they grow
-    for (int r = first_row; r <= last_row; ++r) {
+  for (int leaf = 0; leaf < kWindowLanes; ++leaf) {
+    const int lane = LaneTree<kSums>::laneOfLeaf(leaf);
+    for (int q = 0; q < kSums; ++q) sums[q] = 0.0f;
+    for (int r = first_row; r <= last_row && laneInWindow(lane, half_width, params); ++r) {
       for (int segment = 0; segment < params.window_span; segment += kWindowLanes) {
         const int offset = segment + lane - pad;
         if (offset < -half_width || offset > half_width) continue;
@@ -148,15 +201,10 @@ ELO_HOST_DEVICE bool gatherWindow(const Image& image, int row, int col, int half
         sums[kSzz] = fusedMultiplyAdd(dz, dz, sums[kSzz]);
       }
     }
-    for (int q = 0; q < kSums; ++q) lanes[lane][q] = sums[q];
+    lanes.add(leaf, sums);
   }
-  for (int width = kWindowLanes / 2; width > 0; width /= 2) {
-    for (int i = 0; i < width; ++i) {
-      for (int q = 0; q < kSums; ++q) lanes[i][q] += lanes[i + width][q];
-    }
-  }
-  moments.sum = {lanes[0][kSx], lanes[0][kSy], lanes[0][kSz]};
-  moments.outer = {lanes[0][kSxx], lanes[0][kSxy], lanes[0][kSxz], lanes[0][kSyy], lanes[0][kSyz], lanes[0][kSzz]};
+  moments.sum = {sums[kSx], sums[kSy], sums[kSz]};
+  moments.outer = {sums[kSxx], sums[kSxy], sums[kSxz], sums[kSyy], sums[kSyz], sums[kSzz]};
   moments.count = kept;
   return 2 * distant <= neighbours - 1;  // the centre is not its own neighbour
 }

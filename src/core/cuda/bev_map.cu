@@ -4,8 +4,21 @@
 // Order of the compact points. The CPU backend offers sources one at a time (fillGroundMap()): a cell
 // takes the next slot when it is first offered a point. Here every source offers itself to its cell
 // twice at once, with an atomicMin of its closest-wins key (the first round of which point stays) and of
-// its source index (which source arrived first). The first arrivals, prefix-summed in source order, give
-// the slots, so both backends' maps agree element by element, in the same order.
+// its source index (which source arrived first). A first arrival's slot is the number of first arrivals
+// before it in source order, so both backends' maps agree element by element, in the same order.
+//
+// Three launches per map. Sources are taken in tiles of kThreads, tile t by a block of its own (a
+// grid-stride loop over tiles, as the fusion's source count lives on the device):
+//  1. offerClosest: the first round, and the target map's previous points taken off its grid;
+//  2. offerOldestOnClosestSurface: the second round, each source's first-arrival flag and each tile's
+//     count of first arrivals;
+//  3. writeWinners: a tile's first slot is the sum of the counts of the tiles before it (summed again by
+//     every block: a few hundred integers, cheaper than a launch), each first arrival's slot within the
+//     tile a block scan of the flags; integer sums, exact in any order.
+#include <cub/block/block_reduce.cuh>
+#include <cub/block/block_scan.cuh>
+
+#include "core/common/association.hpp"
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
@@ -14,23 +27,41 @@ namespace elo::cuda {
 
 namespace {
 
-// The points of the scan's ground map come from the pixels of the scan image.
+// The points of the scan's ground map come from the ground pixels of the scan image.
 struct PixelSources {
-  const Float3* vertices;
-  const float* stamps;
+  DeviceScan scan;
 
-  __device__ Float3 vertex(uint32_t source) const { return vertices[source]; }
-  __device__ float stamp(uint32_t source) const { return stamps[source]; }
+  __device__ PixelSources counted() const { return *this; }
+  __device__ int count() const { return scan.pixels(); }
+  __device__ Float3 vertex(uint32_t source) const { return scan.vertices[source]; }
+  __device__ float stamp(uint32_t source) const { return scan.stamps[source]; }
+  // The cell `source` offers itself to (-1: none) and its range.
+  __device__ int offer(int source, const BevProjection& projection, float& range) const {
+    int row = 0;
+    int col = 0;
+    if (scan.labels[source] != PixelLabel::ground || !projection.cellOf(scan.vertices[source], row, col)) return -1;
+    range = norm(scan.vertices[source]);
+    return row * projection.cols + col;
+  }
 };
 
-// The points of a fused ground map: model points 0..model_points-1 moved into the scan's frame, then the
-// scan's ground points.
+// The points of a fused ground map: the model's points moved into the scan's frame, then the scan's
+// ground points. Both counts are read on the device (counted()).
 struct FusionSources {
   DeviceBev model;
-  int model_points;
   DeviceBev scan;
   Rigid3f scan_from_model;
+  ModelFusion fusion;
+  int model_points;
+  int scan_points;
 
+  __device__ FusionSources counted() const {
+    FusionSources sources = *this;
+    sources.model_points = *model.count;
+    sources.scan_points = *scan.count;
+    return sources;
+  }
+  __device__ int count() const { return model_points + scan_points; }
   __device__ bool fromModel(uint32_t source) const { return source < static_cast<uint32_t>(model_points); }
   __device__ Float3 vertex(uint32_t source) const {
     return fromModel(source) ? scan_from_model.apply(model.vertices[source]) : scan.vertices[source - model_points];
@@ -38,105 +69,138 @@ struct FusionSources {
   __device__ float stamp(uint32_t source) const {
     return fromModel(source) ? model.stamps[source] : scan.stamps[source - model_points];
   }
-};
-
-// `source` offers a point at `range` to `cell` (-1: to none).
-__device__ void offer(const CellCompaction& compaction, int source, int cell, float range) {
-  compaction.source_cells[source] = cell;
-  if (cell < 0) return;
-  atomicMin(&compaction.cell_keys[cell], closestWinsKey(range, static_cast<uint32_t>(source)));
-  atomicMin(&compaction.first_sources[cell], static_cast<uint32_t>(source));
-}
-
-__global__ void offerGroundPixels(DeviceScan scan, BevProjection projection, CellCompaction compaction) {
-  const int pixel = globalThread();
-  if (pixel >= scan.pixels()) return;
-  int cell = -1;
-  float range = 0.0f;
-  int row = 0;
-  int col = 0;
-  if (scan.labels[pixel] == PixelLabel::ground && projection.cellOf(scan.vertices[pixel], row, col)) {
-    cell = row * projection.cols + col;
-    range = norm(scan.vertices[pixel]);
-  }
-  offer(compaction, pixel, cell, range);
-}
-
-// Sources beyond the model's points are scan slots; those past the scan's point count offer nothing.
-__global__ void offerFusionSources(FusionSources sources, int source_count, BevProjection projection, ModelFusion fusion,
-                                   CellCompaction compaction) {
-  const int source = globalThread();
-  if (source >= source_count) return;
-  int cell = -1;
-  float range = 0.0f;
-  if (sources.fromModel(source)) {
+  // Model points that expired or left the grid offer themselves to no cell.
+  __device__ int offer(int source, const BevProjection& projection, float& range) const {
+    if (!fromModel(source)) {
+      const int point = source - model_points;
+      range = norm(scan.vertices[point]);
+      return scan.cells[point];
+    }
     int row = 0;
     int col = 0;
-    const Float3 moved = sources.scan_from_model.apply(sources.model.vertices[source]);
-    if (isCurrent(fusion.now, sources.model.stamps[source], fusion.time_window) && projection.cellOf(moved, row, col)) {
-      cell = row * projection.cols + col;
-      range = norm(moved);
+    const Float3 moved = scan_from_model.apply(model.vertices[source]);
+    if (!isCurrent(fusion.now, model.stamps[source], fusion.time_window) || !projection.cellOf(moved, row, col)) {
+      return -1;
     }
-  } else {
-    const int point = source - sources.model_points;
-    if (point < *sources.scan.count) {
-      cell = sources.scan.cells[point];
-      range = norm(sources.scan.vertices[point]);
-    }
+    range = norm(moved);
+    return row * projection.cols + col;
   }
-  offer(compaction, source, cell, range);
+};
+
+__device__ int tilesFor(int sources) { return (sources + kThreads - 1) / kThreads; }
+
+// Takes the map's points off its grid (BevImage::clear()), leaving its count to the caller.
+__device__ void takeOffGrid(const DeviceBev& map) {
+  const int count = *map.count;
+  for (int i = globalThread(); i < count; i += gridThreads()) map.point_of_cell[map.cells[i]] = -1;
+}
+
+// The first round, and the target map's grid emptied for writeWinners (nothing reads it before).
+template <typename Sources>
+__global__ void offerClosest(Sources offered, BevProjection projection, CellCompaction compaction, DeviceBev map) {
+  takeOffGrid(map);  // its count is rewritten by writeWinners
+  const Sources sources = offered.counted();
+  const int count = sources.count();
+  for (int source = globalThread(); source < count; source += gridThreads()) {
+    float range = 0.0f;
+    const int cell = sources.offer(source, projection, range);
+    compaction.source_cells[source] = cell;
+    if (cell < 0) continue;
+    atomicMin(&compaction.cell_keys[cell], closestWinsKey(range, static_cast<uint32_t>(source)));
+    atomicMin(&compaction.first_sources[cell], static_cast<uint32_t>(source));
+  }
 }
 
 // The second round: a source on its cell's closest surface offers its age. Its range is computed as its
-// first offer computed it.
+// first offer computed it. The first round is complete, so is each cell's first arrival.
 template <typename Sources>
-__global__ void offerOldestOnClosestSurface(Sources sources, int source_count, float same_surface_distance,
-                                            CellCompaction compaction) {
-  const int source = globalThread();
-  if (source >= source_count) return;
-  const int cell = compaction.source_cells[source];
-  if (cell < 0) return;
-  const float range = norm(sources.vertex(static_cast<uint32_t>(source)));
-  if (onClosestSurface(range, closestWinsRange(compaction.cell_keys[cell]), same_surface_distance)) {
-    atomicMin(&compaction.surface_keys[cell], oldestWinsKey(sources.stamp(static_cast<uint32_t>(source)),
-                                                           static_cast<uint32_t>(source)));
+__global__ void offerOldestOnClosestSurface(Sources offered, float same_surface_distance, CellCompaction compaction) {
+  const Sources sources = offered.counted();
+  const int count = sources.count();
+  const int tiles = tilesFor(count);
+  for (int tile = blockIdx.x; tile < tiles; tile += gridDim.x) {
+    const int source = tile * kThreads + static_cast<int>(threadIdx.x);
+    const int cell = source < count ? compaction.source_cells[source] : -1;
+    bool first = false;
+    if (cell >= 0) {
+      first = compaction.first_sources[cell] == static_cast<uint32_t>(source);
+      const float range = norm(sources.vertex(static_cast<uint32_t>(source)));
+      if (onClosestSurface(range, closestWinsRange(compaction.cell_keys[cell]), same_surface_distance)) {
+        atomicMin(&compaction.surface_keys[cell],
+                  oldestWinsKey(sources.stamp(static_cast<uint32_t>(source)), static_cast<uint32_t>(source)));
+      }
+    }
+    if (source < count) compaction.first_flags[source] = first ? 1 : 0;
+    const int tile_firsts = __syncthreads_count(first);
+    if (threadIdx.x == 0) compaction.tile_firsts[tile] = tile_firsts;
   }
 }
 
-__global__ void flagFirstArrivals(int source_count, CellCompaction compaction) {
-  const int source = globalThread();
-  if (source >= source_count) return;
-  const int cell = compaction.source_cells[source];
-  compaction.first_flags[source] = cell >= 0 && compaction.first_sources[cell] == static_cast<uint32_t>(source) ? 1 : 0;
+using TileReduce = cub::BlockReduce<int, kThreads>;
+using TileScan = cub::BlockScan<int, kThreads>;
+
+// The first arrivals in the tiles before `tile`, in every thread of the block.
+__device__ int firstsBefore(const int* tile_firsts, int tile, TileReduce::TempStorage& storage, int& shared_sum) {
+  int sum = 0;
+  for (int i = static_cast<int>(threadIdx.x); i < tile; i += kThreads) sum += tile_firsts[i];
+  sum = TileReduce(storage).Sum(sum);
+  if (threadIdx.x == 0) shared_sum = sum;
+  __syncthreads();
+  const int before = shared_sum;
+  __syncthreads();  // shared_sum and `storage` are free again
+  return before;
 }
 
 // The first arrival in each cell writes the cell's winner into its slot and returns the cell's scratch to
 // "none"; no other thread touches that cell here.
 template <typename Sources>
-__global__ void writeWinners(Sources sources, int source_count, CellCompaction compaction, DeviceBev map) {
-  const int source = globalThread();
-  if (source >= source_count) return;
-  if (source == source_count - 1) *map.count = compaction.offsets[source] + compaction.first_flags[source];
-  if (compaction.first_flags[source] == 0) return;
-  const int cell = compaction.source_cells[source];
-  const uint32_t winner = closestWinsSource(compaction.surface_keys[cell]);
-  const int slot = compaction.offsets[source];
-  const Float3 vertex = sources.vertex(winner);
-  map.cells[slot] = cell;
-  map.vertices[slot] = vertex;
-  map.ranges[slot] = norm(vertex);
-  map.stamps[slot] = sources.stamp(winner);
-  map.point_of_cell[cell] = slot;
-  compaction.cell_keys[cell] = kNoClosestKey;
-  compaction.surface_keys[cell] = kNoClosestKey;
-  compaction.first_sources[cell] = kNoSource;
+__global__ void writeWinners(Sources offered, CellCompaction compaction, DeviceBev map) {
+  __shared__ TileReduce::TempStorage reduce_storage;
+  __shared__ TileScan::TempStorage scan_storage;
+  __shared__ int shared_sum;
+  const Sources sources = offered.counted();
+  const int count = sources.count();
+  const int tiles = tilesFor(count);
+  if (tiles == 0 && globalThread() == 0) *map.count = 0;
+  for (int tile = blockIdx.x; tile < tiles; tile += gridDim.x) {
+    const int tile_slot = firstsBefore(compaction.tile_firsts, tile, reduce_storage, shared_sum);
+    const int source = tile * kThreads + static_cast<int>(threadIdx.x);
+    const int first = source < count ? compaction.first_flags[source] : 0;
+    int slot_in_tile = 0;
+    int tile_firsts = 0;
+    TileScan(scan_storage).ExclusiveSum(first, slot_in_tile, tile_firsts);
+    __syncthreads();  // scan_storage is free again for the next tile
+    if (tile == tiles - 1 && threadIdx.x == 0) *map.count = tile_slot + tile_firsts;
+    if (first == 0) continue;
+    const int cell = compaction.source_cells[source];
+    const uint32_t winner = closestWinsSource(compaction.surface_keys[cell]);
+    const int slot = tile_slot + slot_in_tile;
+    const Float3 vertex = sources.vertex(winner);
+    map.cells[slot] = cell;
+    map.vertices[slot] = vertex;
+    map.ranges[slot] = norm(vertex);
+    map.stamps[slot] = sources.stamp(winner);
+    map.point_of_cell[cell] = slot;
+    compaction.cell_keys[cell] = kNoClosestKey;
+    compaction.surface_keys[cell] = kNoClosestKey;
+    compaction.first_sources[cell] = kNoSource;
+  }
 }
 
-// Empties the grid cells of the map's points (BevImage::clear()); the count is left to the caller.
-__global__ void clearCells(DeviceBev map) {
-  const int count = *map.count;
-  for (int i = globalThread(); i < count; i += gridThreads()) map.point_of_cell[map.cells[i]] = -1;
+// Runs the three launches above with `blocks` blocks: enough for every tile where the source count is
+// known on the host, a fixed grid where it lives on the device.
+template <typename Sources>
+void compact(const Sources& sources, int blocks, const BevProjection& projection, float same_surface_distance,
+             const CellCompaction& compaction, const DeviceBev& map, cudaStream_t stream) {
+  offerClosest<<<blocks, kThreads, 0, stream>>>(sources, projection, compaction, map);
+  checkLaunch("offerClosest");
+  offerOldestOnClosestSurface<<<blocks, kThreads, 0, stream>>>(sources, same_surface_distance, compaction);
+  checkLaunch("offerOldestOnClosestSurface");
+  writeWinners<<<blocks, kThreads, 0, stream>>>(sources, compaction, map);
+  checkLaunch("writeWinners");
 }
+
+__global__ void clearCells(DeviceBev map) { takeOffGrid(map); }
 
 __global__ void copyPoints(DeviceBev from, DeviceBev to) {
   const int count = *from.count;
@@ -150,6 +214,9 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
   }
 }
 
+// One thread per model point: its patch search (groundNormal()) stops after a ring or two, a chain of
+// dependent loads that the GPU hides only with many threads in flight (kWideGridBlocks). Copying each
+// thread's whole patch to shared memory first loaded every cell of it, and was slower.
 __global__ void groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius,
                               Float3* normals) {
   const int count = *model.count;
@@ -158,64 +225,38 @@ __global__ void groundNormals(DeviceBev model, BevProjection projection, int wan
   }
 }
 
-void clearCellsOf(const DeviceBev& map, cudaStream_t stream) {
-  clearCells<<<kGridStrideBlocks, kThreads, 0, stream>>>(map);
-  checkLaunch("clearCells");
-}
-
-// Runs the second round over the offers made, flags their first arrivals, sums them into slots and writes
-// the winners into `map`.
-template <typename Sources>
-void compactWinners(const Sources& sources, int source_count, float same_surface_distance,
-                    const CellCompaction& compaction, const DeviceBev& map, cudaStream_t stream) {
-  offerOldestOnClosestSurface<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count,
-                                                                                same_surface_distance, compaction);
-  checkLaunch("offerOldestOnClosestSurface");
-  flagFirstArrivals<<<blocksFor(source_count), kThreads, 0, stream>>>(source_count, compaction);
-  checkLaunch("flagFirstArrivals");
-  exclusiveSum(compaction.first_flags, compaction.offsets, source_count, compaction.scan_scratch,
-               compaction.scan_scratch_bytes, stream);
-  writeWinners<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count, compaction, map);
-  checkLaunch("writeWinners");
-}
-
 }  // namespace
+
+size_t compactionTiles(size_t sources) { return (sources + kThreads - 1) / kThreads; }
 
 void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
                     const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream) {
-  const int pixels = scan.pixels();
-  clearCellsOf(ground, stream);
-  offerGroundPixels<<<blocksFor(pixels), kThreads, 0, stream>>>(scan, projection, compaction);
-  checkLaunch("offerGroundPixels");
-  compactWinners(PixelSources{scan.vertices, scan.stamps}, pixels, same_surface_distance, compaction, ground, stream);
+  compact(PixelSources{scan}, blocksFor(scan.pixels()), projection, same_surface_distance, compaction, ground, stream);
 }
 
-void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
-                     const BevProjection& projection, const Rigid3f& scan_from_model, const ModelFusion& fusion,
-                     const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream) {
-  const FusionSources sources{model, model_points, scan_ground, scan_from_model};
-  const int source_count = model_points + scan_slots;
-  clearCellsOf(fused, stream);
-  offerFusionSources<<<blocksFor(source_count), kThreads, 0, stream>>>(sources, source_count, projection, fusion,
-                                                                       compaction);
-  checkLaunch("offerFusionSources");
-  compactWinners(sources, source_count, fusion.same_surface_distance, compaction, fused, stream);
+void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const BevProjection& projection,
+                     const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
+                     const CellCompaction& compaction, cudaStream_t stream) {
+  const FusionSources sources{model, scan_ground, scan_from_model, fusion, 0, 0};
+  compact(sources, kWideGridBlocks, projection, fusion.same_surface_distance, compaction, fused, stream);
 }
 
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream) {
-  clearCellsOf(to, stream);
+  clearCells<<<kGridStrideBlocks, kThreads, 0, stream>>>(to);
+  checkLaunch("clearCells");
   copyPoints<<<kGridStrideBlocks, kThreads, 0, stream>>>(from, to);
   checkLaunch("copyPoints");
 }
 
 void clearGroundMap(const DeviceBev& map, cudaStream_t stream) {
-  clearCellsOf(map, stream);
+  clearCells<<<kGridStrideBlocks, kThreads, 0, stream>>>(map);
+  checkLaunch("clearCells");
   check(cudaMemsetAsync(map.count, 0, sizeof(int), stream), "clearing a ground map's count");
 }
 
 void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
                       Float3* normals, cudaStream_t stream) {
-  groundNormals<<<kGridStrideBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
+  groundNormals<<<kWideGridBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
   checkLaunch("groundNormals");
 }
 

@@ -17,6 +17,10 @@ static_assert(sizeof(PixelLabel) == 1, "labels copy byte for byte");
 
 using Clock = std::chrono::steady_clock;
 
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
 template <typename T>
 void clear(const DeviceArray<T>& array, size_t count, int byte, cudaStream_t stream) {
   check(cudaMemsetAsync(array.data(), byte, count * sizeof(T), stream), "cudaMemsetAsync");
@@ -62,8 +66,16 @@ CudaBackend::CudaBackend(const Config& config)
       pixels_(static_cast<size_t>(spherical_.rows) * spherical_.cols),
       cells_(static_cast<size_t>(bev_.rows) * bev_.cols) {
   for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  check(cudaGetDevice(&device_), "cudaGetDevice");
   allocate();
   clearDevice();
+}
+
+// No copy may be reading pinned memory, nor a kernel device memory, when the buffers are freed.
+CudaBackend::~CudaBackend() {
+  uploads_.finish();
+  cudaStreamSynchronize(upload_stream_.get());
+  cudaStreamSynchronize(stream_.get());
 }
 
 void CudaBackend::allocate() {
@@ -77,6 +89,7 @@ void CudaBackend::allocate() {
   pixel_times_.reserve(pixels_);
   pixel_keys_.reserve(pixels_);
   closest_keys_.reserve(pixels_);
+  pixel_surface_keys_.reserve(pixels_);
   registration_flags_.reserve(pixels_);
   registration_offsets_.reserve(pixels_);
   registration_pixels_.reserve(pixels_);
@@ -93,13 +106,13 @@ void CudaBackend::allocate() {
   first_sources_.reserve(cells_);
   source_cells_.reserve(sources);
   first_flags_.reserve(sources);
-  source_offsets_.reserve(sources);
-  scan_scratch_bytes_ = exclusiveSumScratchBytes(static_cast<int>(sources));
+  tile_firsts_.reserve(compactionTiles(sources));
+  scan_scratch_bytes_ = exclusiveSumScratchBytes(static_cast<int>(pixels_));  // the registration pixels
   scan_scratch_.reserve(scan_scratch_bytes_);
   counts_.reserve(kCounts);
   host_counts_.reserve(kCounts);
-  partial_sums_.reserve(kTerms * kReductionBlocks);
-  term_sums_.reserve(kTerms);
+  partial_sums_.reserve(kTerms * kPartialRows * kReductionBlocks);
+  finished_blocks_.reserve(1);
   host_term_sums_.reserve(kTerms);
 }
 
@@ -119,28 +132,26 @@ void CudaBackend::clearDevice() {
   for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1]}) {
     clear(map->point_of_cell, cells_, 0xff, stream);
   }
+  clear(closest_keys_, pixels_, 0xff, stream);
+  clear(pixel_surface_keys_, pixels_, 0xff, stream);
   clear(cell_keys_, cells_, 0xff, stream);
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
+  // linearize()'s count of the blocks done at 0, and its partial sums initialised: its last block reads
+  // (and drops) the rows of a term not summed.
+  clear(finished_blocks_, 1, 0, stream);
+  clear(partial_sums_, kTerms * kPartialRows * kReductionBlocks, 0, stream);
   for (int count = 0; count < kCounts; ++count) host_counts_[count] = 0;
   synchronize();
 }
 
-void CudaBackend::synchronize() {
-  check(cudaStreamSynchronize(stream_.get()), "running the CUDA stages");
-  model_points_fetched_ = true;
-}
+void CudaBackend::synchronize() { check(cudaStreamSynchronize(stream_.get()), "running the CUDA stages"); }
 
 void CudaBackend::fetchCount(int count) {
   check(cudaMemcpyAsync(&host_counts_[count], counts_.data() + count, sizeof(int), cudaMemcpyDeviceToHost,
                         stream_.get()),
         "copying a count to the host");
-}
-
-int CudaBackend::modelPoints() {
-  if (!model_points_fetched_) synchronize();
-  return host_counts_[kModelPoints + current_];
 }
 
 DeviceScan CudaBackend::deviceScan() const {
@@ -161,63 +172,106 @@ DeviceBev CudaBackend::deviceBev(const BevBuffers& buffers, int count) const {
 }
 
 CellCompaction CudaBackend::compaction() const {
-  return {cell_keys_.data(),      surface_keys_.data(), first_sources_.data(), source_cells_.data(),  first_flags_.data(),
-          source_offsets_.data(), scan_scratch_.data(),  scan_scratch_bytes_};
+  return {cell_keys_.data(),    surface_keys_.data(), first_sources_.data(),
+          source_cells_.data(), first_flags_.data(),  tile_firsts_.data()};
 }
 
-// Stages the cloud in pinned memory and queues its copy to the device between two events, which time it.
-void CudaBackend::upload(const PointCloud& cloud, bool with_times) {
+void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
+  check(cudaEventSynchronize(copied.get()), "waiting for the last copy of an upload buffer");
+  check(cudaEventSynchronize(projected.get()), "waiting for the last projection of an upload buffer");
+  count = cloud.count;
+  has_rings = cloud.rings != nullptr;
+  has_times = cloud.times != nullptr;
+  if (count == 0) return;
+  staged_points.reserve(count);
+  points.reserve(count);
+  std::memcpy(staged_points.data(), cloud.points, count * sizeof(Float3));
+  if (has_rings) {
+    staged_rings.reserve(count);
+    rings.reserve(count);
+    std::memcpy(staged_rings.data(), cloud.rings, count * sizeof(uint16_t));
+  }
+  if (has_times) {
+    staged_times.reserve(count);
+    times.reserve(count);
+    std::memcpy(staged_times.data(), cloud.times, count * sizeof(float));
+  }
+}
+
+void CudaBackend::UploadBuffers::copy(cudaStream_t stream) {
+  if (count == 0) return;
+  check(cudaMemcpyAsync(points.data(), staged_points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
+        "uploading the cloud");
+  if (has_rings) {
+    check(cudaMemcpyAsync(rings.data(), staged_rings.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice, stream),
+          "uploading the rings");
+  }
+  if (has_times) {
+    check(cudaMemcpyAsync(times.data(), staged_times.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
+          "uploading the per-point times");
+  }
+}
+
+CudaBackend::HostCloud CudaBackend::hostCloud(const PointCloud& cloud, bool with_times) const {
   const size_t count = cloud.points.size();
-  uploaded_rings_ = !ring_rows_.empty() && cloud.ring.size() == count;
-  staged_points_.reserve(count);
-  points_.reserve(count);
-  if (uploaded_rings_) {
-    staged_rings_.reserve(count);
-    rings_.reserve(count);
-  }
-  if (with_times) {
-    staged_times_.reserve(count);
-    times_.reserve(count);
-  }
-  const Clock::time_point staging_start = Clock::now();
-  if (count > 0) {
-    std::memcpy(staged_points_.data(), cloud.points.data(), count * sizeof(Float3));
-    if (uploaded_rings_) std::memcpy(staged_rings_.data(), cloud.ring.data(), count * sizeof(uint16_t));
-    if (with_times) std::memcpy(staged_times_.data(), cloud.time.data(), count * sizeof(float));
-  }
-  upload_milliseconds_ = std::chrono::duration<double, std::milli>(Clock::now() - staging_start).count();
+  const bool with_rings = !ring_rows_.empty() && cloud.ring.size() == count;
+  return {cloud.points.data(), with_rings ? cloud.ring.data() : nullptr, with_times ? cloud.time.data() : nullptr,
+          count};
+}
+
+// The cloud's times go up when the odometry may deskew by them. The staging thread reads the cloud's
+// arrays, not the PointCloud, which the caller may move meanwhile.
+void CudaBackend::prefetch(const PointCloud& cloud) {
+  const bool with_times = config_.deskew.time_source == TimeSource::field && cloud.time.size() == cloud.points.size();
+  const HostCloud host = hostCloud(cloud, with_times);
+  uploads_.prefetch(CloudIdentity::of(cloud), with_times, [this, host](UploadBuffers& buffers) {
+    check(cudaSetDevice(device_), "selecting the device");
+    buffers.stage(host);
+    buffers.copy(upload_stream_.get());
+    check(cudaEventRecord(buffers.copied.get(), upload_stream_.get()), "cudaEventRecord");
+  });
+}
+
+void CudaBackend::finishPrefetch() noexcept {
+  const Clock::time_point wait_start = Clock::now();
+  uploads_.finish();
+  upload_milliseconds_ += millisecondsSince(wait_start);
+}
+
+// A prefetched cloud: the stream waits for its copy, between two events that time the wait. Any other
+// cloud is staged here and copied on the stream between the two events.
+const CudaBackend::UploadBuffers& CudaBackend::upload(const PointCloud& cloud, bool with_times) {
   const cudaStream_t stream = stream_.get();
+  const Clock::time_point start = Clock::now();
+  const auto taken = uploads_.take(CloudIdentity::of(cloud), with_times);
+  UploadBuffers& buffers = taken.buffers;
+  if (!taken.prefetched) buffers.stage(hostCloud(cloud, with_times));
+  upload_milliseconds_ = millisecondsSince(start);
   check(cudaEventRecord(upload_start_.get(), stream), "cudaEventRecord");
-  if (count > 0) {
-    check(cudaMemcpyAsync(points_.data(), staged_points_.data(), count * sizeof(Float3), cudaMemcpyHostToDevice, stream),
-          "uploading the cloud");
-    if (uploaded_rings_) {
-      check(cudaMemcpyAsync(rings_.data(), staged_rings_.data(), count * sizeof(uint16_t), cudaMemcpyHostToDevice,
-                            stream),
-            "uploading the rings");
-    }
-    if (with_times) {
-      check(cudaMemcpyAsync(times_.data(), staged_times_.data(), count * sizeof(float), cudaMemcpyHostToDevice, stream),
-            "uploading the per-point times");
-    }
+  if (taken.prefetched) {
+    check(cudaStreamWaitEvent(stream, buffers.copied.get(), 0), "waiting for the prefetched upload");
+  } else {
+    buffers.copy(stream);
   }
   check(cudaEventRecord(upload_end_.get(), stream), "cudaEventRecord");
+  return buffers;
 }
 
 size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
   SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
   const bool with_times = deskew.timing.source == TimeSource::field;
-  upload(cloud, with_times);
-  deskew.times = with_times ? times_.data() : nullptr;
+  const UploadBuffers& buffers = upload(cloud, with_times);
+  deskew.times = with_times ? buffers.times.data() : nullptr;
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
-  const UploadedCloud uploaded{points_.data(), uploaded_rings_ ? rings_.data() : nullptr,
-                               static_cast<int>(cloud.points.size())};
+  const UploadedCloud uploaded{buffers.points.data(), buffers.has_rings ? buffers.rings.data() : nullptr,
+                               static_cast<int>(buffers.count)};
   cuda::projectScan(uploaded, spherical_, correction_, deskew, ring_rows_device_.data(),
                     static_cast<int>(ring_rows_.size()), stamp, pixel_keys_.data(), deviceScan(),
                     counts_.data() + kOccupiedPixels, stream_.get());
+  check(cudaEventRecord(buffers.projected.get(), stream_.get()), "cudaEventRecord");
   fetchCount(kOccupiedPixels);
-  synchronize();  // the caller needs the count; the pinned staging buffer is free again after this
+  synchronize();  // the caller needs the count
   float copy_milliseconds = 0.0f;
   check(cudaEventElapsedTime(&copy_milliseconds, upload_start_.get(), upload_end_.get()), "cudaEventElapsedTime");
   upload_milliseconds_ += copy_milliseconds;
@@ -274,10 +328,8 @@ NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan,
   inputs.gates = gates_;
   inputs.motion = toRigid3f(model_from_scan);
   inputs.kernel_scale = kernel_scale;
-  cuda::linearize(inputs, partial_sums_.data(), term_sums_.data(), stream_.get());
-  check(cudaMemcpyAsync(host_term_sums_.data(), term_sums_.data(), kTerms * sizeof(DeviceTermSums),
-                        cudaMemcpyDeviceToHost, stream_.get()),
-        "copying the sums to the host");
+  // The launch writes the sums into host_term_sums_ itself: one synchronisation and no copy.
+  cuda::linearize(inputs, {partial_sums_.data(), finished_blocks_.data()}, host_term_sums_.data(), stream_.get());
   synchronize();
   NormalEquations sums;
   sums.nonground = toTermSums(host_term_sums_[0]);
@@ -295,26 +347,22 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
     const int next = 1 - current_;
     cuda::fuseSphericalModel(deviceModel(current_), deviceScan(), spherical_, scan_from_model, fusion,
-                             closest_keys_.data(), pixel_keys_.data(), deviceModel(next), stream);
-    cuda::fuseGroundModel(modelGroundMap(current_), modelPoints(), scanGroundMap(), static_cast<int>(pixels_), bev_,
-                          scan_from_model, fusion, modelGroundMap(next), compaction(), stream);
+                             closest_keys_.data(), pixel_surface_keys_.data(), deviceModel(next), stream);
+    cuda::fuseGroundModel(modelGroundMap(current_), scanGroundMap(), bev_, scan_from_model, fusion,
+                          modelGroundMap(next), compaction(), stream);
     current_ = next;
   }
   model_initialized_ = true;
   cuda::fitGroundNormals(modelGroundMap(current_), bev_, config_.bev.normal_neighbours,
                          config_.bev.normal_patch_radius, model_ground_normals_.data(), stream);
-  fetchCount(kModelPoints + current_);
-  model_points_fetched_ = false;
   model_view_current_ = false;
 }
 
 void CudaBackend::resetModel() {
-  synchronize();  // no copy into host_counts_ may be under way while it is written below
   const cudaStream_t stream = stream_.get();
   clear(model_image_[current_].ranges, pixels_, 0, stream);
   clear(model_image_[current_].normals, pixels_, 0, stream);
   cuda::clearGroundMap(modelGroundMap(current_), stream);
-  host_counts_[kModelPoints + current_] = 0;
   model_initialized_ = false;
   model_view_current_ = false;
 }
@@ -372,7 +420,9 @@ const Model& CudaBackend::model() {
   copyToHost(model_view_.nonground.normal, image.normals.data(), pixels_, stream);
   copyToHost(model_view_.nonground.range, image.ranges.data(), pixels_, stream);
   copyToHost(model_view_.nonground.stamp, image.stamps.data(), pixels_, stream);
-  copyBevView(model_ground_[current_], modelPoints(), model_view_.ground);
+  fetchCount(kModelPoints + current_);
+  synchronize();  // the count, before the points are copied
+  copyBevView(model_ground_[current_], host_counts_[kModelPoints + current_], model_view_.ground);
   model_view_.initialized = model_initialized_;
   model_view_current_ = true;
   return model_view_;

@@ -1,13 +1,15 @@
 // The CUDA implementation of the backend interface: the stages of src/core/cuda/*.cu, queued on one
 // stream over device buffers that mirror include/elo/types.hpp and are allocated once, in the
 // constructor (only the cloud upload grows, when a scan has more points than any before). The scan
-// goes up through pinned memory. The host views are copied back when asked for, and only when the
-// device buffers changed since.
+// goes up through pinned memory, in one of two upload buffers: the next scan, when prefetched, is staged
+// into the other one on a thread of its own and copied on a stream of its own while this one is
+// processed. The host views are copied back when asked for, and only when the device buffers changed since.
 #pragma once
 
 #include <vector>
 
 #include "core/cuda/device_buffer.hpp"
+#include "core/double_buffered_upload.hpp"
 #include "core/cuda/kernels.hpp"
 #include "elo/backend.hpp"
 
@@ -16,6 +18,7 @@ namespace elo::cuda {
 class CudaBackend final : public Backend {
  public:
   explicit CudaBackend(const Config& config);
+  ~CudaBackend() override;
 
   const char* name() const override { return "cuda"; }
   size_t projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) override;
@@ -32,6 +35,8 @@ class CudaBackend final : public Backend {
   const Model& model() override;
 
   void synchronize() override;
+  void prefetch(const PointCloud& cloud) override;
+  void finishPrefetch() noexcept override;
   double lastUploadMilliseconds() const override { return upload_milliseconds_; }
 
  private:
@@ -56,10 +61,43 @@ class CudaBackend final : public Backend {
   // point counts of the two model buffers are at kModelPoints and kModelPoints + 1.
   enum Count { kOccupiedPixels, kRegistrationPixels, kScanGroundPoints, kModelPoints, kCounts = kModelPoints + 2 };
 
+  // A cloud's arrays as an upload reads them; `rings` and `times` are null when they do not go up.
+  struct HostCloud {
+    const Vec3f* points = nullptr;
+    const uint16_t* rings = nullptr;
+    const float* times = nullptr;
+    size_t count = 0;
+  };
+  // One scan's upload (DoubleBufferedUpload): the cloud staged in pinned memory and copied to the device.
+  // Staging waits until the copy that read the pinned memory last (`copied`) and the projection that read
+  // the device copy last (`projected`) are done.
+  struct UploadBuffers {
+    PinnedArray<Float3> staged_points;
+    PinnedArray<uint16_t> staged_rings;
+    PinnedArray<float> staged_times;
+    DeviceArray<Float3> points;
+    DeviceArray<uint16_t> rings;
+    DeviceArray<float> times;
+    Event copied{cudaEventDisableTiming};
+    Event projected{cudaEventDisableTiming};
+    // The points staged, and whether their rings and times are there.
+    size_t count = 0;
+    bool has_rings = false;
+    bool has_times = false;
+
+    // Copies `cloud` into the pinned memory, growing the buffers as needed.
+    void stage(const HostCloud& cloud);
+    // Queues the copy of the staged cloud to the device on `stream`.
+    void copy(cudaStream_t stream);
+  };
+
   void allocate();
   void clearDevice();
-  // Uploads the points, their rings when the projection uses them and their times when `with_times`.
-  void upload(const PointCloud& cloud, bool with_times);
+  HostCloud hostCloud(const PointCloud& cloud, bool with_times) const;
+  // Uploads the points, their rings when the projection uses them and their times when `with_times`, or
+  // waits for their prefetched upload; returns the buffers that hold them on the device. Records
+  // upload_start_ and upload_end_ on the stream around the copy, or the wait for it.
+  const UploadBuffers& upload(const PointCloud& cloud, bool with_times);
   DeviceScan deviceScan() const;
   DeviceModelImage deviceModel(int buffer) const;
   DeviceBev deviceBev(const BevBuffers& buffers, int count) const;
@@ -68,8 +106,6 @@ class CudaBackend final : public Backend {
   CellCompaction compaction() const;
   // Copies count `count` into host_counts_ once the stream gets there.
   void fetchCount(int count);
-  // The current model's point count, waiting for the stream when its copy may still be under way.
-  int modelPoints();
   void copyBevView(const BevBuffers& buffers, int points, BevImage& view);
 
   Config config_;
@@ -83,19 +119,12 @@ class CudaBackend final : public Backend {
   size_t cells_;
   std::vector<int> ring_rows_;
 
+  int device_ = 0;  // the thread that stages prefetched uploads works on it too
   Stream stream_;
+  Stream upload_stream_;  // the prefetched uploads' copies
   Event upload_start_;
   Event upload_end_;
   double upload_milliseconds_ = 0.0;
-  bool uploaded_rings_ = false;
-
-  // The cloud, staged in pinned memory.
-  PinnedArray<Float3> staged_points_;
-  PinnedArray<uint16_t> staged_rings_;
-  PinnedArray<float> staged_times_;
-  DeviceArray<Float3> points_;
-  DeviceArray<uint16_t> rings_;
-  DeviceArray<float> times_;
   DeviceArray<int> ring_rows_device_;
 
   // The scan image, its registration pixels and its ground map.
@@ -108,7 +137,8 @@ class CudaBackend final : public Backend {
   TimeSource scan_times_ = TimeSource::none;
   SweepVelocity scan_velocity_{};
   DeviceArray<ClosestKey> pixel_keys_;
-  DeviceArray<ClosestKey> closest_keys_;  // the model update's first round
+  DeviceArray<ClosestKey> closest_keys_;        // the model update's first round
+  DeviceArray<ClosestKey> pixel_surface_keys_;  // ... and its second
   DeviceArray<int> registration_flags_;
   DeviceArray<int> registration_offsets_;
   DeviceArray<int> registration_pixels_;
@@ -120,7 +150,6 @@ class CudaBackend final : public Backend {
   DeviceArray<Float3> model_ground_normals_;  // of the current model's points
   int current_ = 0;
   bool model_initialized_ = false;
-  bool model_points_fetched_ = true;  // host_counts_ holds the current model's point count
 
   // Scratch of the BEV compaction (sources: every model point and every scan pixel).
   DeviceArray<ClosestKey> cell_keys_;
@@ -128,14 +157,15 @@ class CudaBackend final : public Backend {
   DeviceArray<uint32_t> first_sources_;
   DeviceArray<int> source_cells_;
   DeviceArray<int> first_flags_;
-  DeviceArray<int> source_offsets_;
+  DeviceArray<int> tile_firsts_;
+  // The scan of the registration pixels' flags (estimateNormals()).
   size_t scan_scratch_bytes_ = 0;
   DeviceArray<unsigned char> scan_scratch_;
 
   DeviceArray<int> counts_;
   PinnedArray<int> host_counts_;
-  DeviceArray<DeviceTermSums> partial_sums_;
-  DeviceArray<DeviceTermSums> term_sums_;
+  DeviceArray<double> partial_sums_;       // linearize()'s scratch
+  DeviceArray<unsigned> finished_blocks_;  // 0 between launches
   PinnedArray<DeviceTermSums> host_term_sums_;
 
   // Host views, filled on demand.
@@ -145,6 +175,10 @@ class CudaBackend final : public Backend {
   bool scan_view_current_ = false;
   bool scan_ground_view_current_ = false;
   bool model_view_current_ = false;
+
+  // The scans' uploads: a prefetched cloud is staged on the uploads' own thread and copied on
+  // upload_stream_, any other one here and on stream_. Last: its thread stops before the streams go.
+  DoubleBufferedUpload<UploadBuffers> uploads_;
 };
 
 }  // namespace elo::cuda

@@ -22,18 +22,19 @@ namespace elo::cuda {
 constexpr uint32_t kNoSource = ~uint32_t{0};  // all bytes 0xff
 
 // Scratch of "closest wins per cell, in order of first arrival" (bev_map.cu). Per BEV cell: the
-// closest-wins key and the lowest source offered to it, both back to "none" after each use. Per source:
-// its cell (-1: none), whether it arrived first in that cell, and the exclusive sum of those flags.
+// closest-wins key and the lowest source offered to it, all back to "none" (all bytes 0xff) after each
+// use. Per source: its cell (-1: none) and whether it arrived first in that cell; per tile of sources
+// (compactionTiles()), its count of first arrivals.
 struct CellCompaction {
   ClosestKey* cell_keys;     // first round: the closest offer per cell
   ClosestKey* surface_keys;  // second round: the oldest offer on its closest surface (model_update.hpp)
   uint32_t* first_sources;
   int* source_cells;
   int* first_flags;
-  int* offsets;
-  void* scan_scratch;  // for exclusiveSum()
-  size_t scan_scratch_bytes;
+  int* tile_firsts;
 };
+// The tiles of `sources` sources, the size of CellCompaction::tile_firsts.
+size_t compactionTiles(size_t sources);
 
 // A list of the flagged items of a range, in order (the registration pixels).
 struct FlaggedList {
@@ -79,10 +80,10 @@ void estimateNormals(const DeviceScan& scan, const NormalParams& params, const F
 // (model_update.hpp), the points in the order the CPU backend inserts them (see bev_map.cu).
 void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
                     const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream);
-// `model_points`: the model's point count; `scan_slots`: a bound on the scan's (its pixel count).
-void fuseGroundModel(const DeviceBev& model, int model_points, const DeviceBev& scan_ground, int scan_slots,
-                     const BevProjection& projection, const Rigid3f& scan_from_model, const ModelFusion& fusion,
-                     const DeviceBev& fused, const CellCompaction& compaction, cudaStream_t stream);
+// The point counts of `model` and `scan_ground` are read on the device: nothing waits for them.
+void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const BevProjection& projection,
+                     const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
+                     const CellCompaction& compaction, cudaStream_t stream);
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream);
 void clearGroundMap(const DeviceBev& map, cudaStream_t stream);
 // The normal of every model point (groundNormal() of association.hpp), into `normals`.
@@ -90,25 +91,30 @@ void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, i
                       Float3* normals, cudaStream_t stream);
 
 // model_update.cu: the non-ground model (Sec. III-D).
-// `closest_keys` and `pixel_keys` are scratch for the two rounds (model_update.hpp).
+// `closest_keys` and `surface_keys`, one per pixel, are scratch for the two rounds (model_update.hpp):
+// "none" (all bytes 0xff) before, and again after.
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
                         const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
-                        ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream);
+                        ClosestKey* surface_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
 // correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A), packed as
-// point_to_plane.hpp lays them out.
+// point_to_plane.hpp lays them out, in one launch.
 struct DeviceTermSums {
   double values[kTermValues];
   int candidates;
   int inliers;
 };
 constexpr int kTerms = 2;  // 0: non-ground (E_S), 1: ground (E_G)
-// Fixed, so that every GPU sums in the same order: results are reproducible run to run and across GPUs.
-constexpr int kReductionBlocks = 256;
+// Blocks per term. Fixed, so that every GPU sums in the same order: results are reproducible run to run
+// and across GPUs. Both terms' blocks (2 x 128 of kThreads, about 120 registers a thread: two blocks an
+// SM) make one wave on a GPU of 128 SMs or more (an H100 has 132); a smaller GPU runs more waves.
+constexpr int kReductionBlocks = 128;
+// Rows of a block's partial sums: the packed sums, then the candidate and inlier counts.
+constexpr int kPartialRows = kTermValues + 2;
 
 struct LinearizeInputs {
-  bool nonground;  // which terms to sum; a term left out sums to zero
+  bool nonground;  // which terms to sum, at least one; a term left out sums to zero
   bool ground;
   DeviceScan scan;
   const int* registration_pixels;
@@ -124,7 +130,16 @@ struct LinearizeInputs {
   Rigid3f motion;
   double kernel_scale;
 };
-// `partials`: kTerms * kReductionBlocks per-block sums; `results`: kTerms totals.
-void linearize(const LinearizeInputs& inputs, DeviceTermSums* partials, DeviceTermSums* results, cudaStream_t stream);
+// The scratch of linearize(): every block's partial sums, term by term and row by row
+// (kTerms * kPartialRows * kReductionBlocks), and the count of the blocks done, which must be 0 before
+// the first launch and is 0 again after each.
+struct LinearizeScratch {
+  double* partials;
+  unsigned* finished_blocks;
+};
+// `results`: the kTerms totals, written by the launch's last block. Pinned host memory (addressable by
+// the device under unified addressing), so that the host reads them once the stream has got there.
+void linearize(const LinearizeInputs& inputs, const LinearizeScratch& scratch, DeviceTermSums* results,
+               cudaStream_t stream);
 
 }  // namespace elo::cuda

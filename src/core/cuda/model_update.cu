@@ -2,7 +2,8 @@
 // offers itself to the pixel it projects to, every scan pixel that joins the model offers itself to its
 // own pixel, and each pixel takes the oldest offer on its closest surface (two rounds of atomicMin, the
 // rules of model_update.hpp that the CPU backend applies too). The fused image is written to a second
-// buffer, so no thread reads what another writes.
+// buffer, so no thread reads what another writes. Three launches; the last one returns both rounds' keys
+// to "none" for the next update, which so needs no clearing of its own.
 #include "core/common/model_update.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
@@ -43,22 +44,25 @@ __global__ void offerClosest(DeviceModelImage model, DeviceScan scan, SphericalP
 
 __global__ void offerOldestOnClosestSurface(DeviceModelImage model, DeviceScan scan, SphericalProjection projection,
                                             Rigid3f scan_from_model, ModelFusion fusion,
-                                            const ClosestKey* closest_keys, ClosestKey* pixel_keys) {
+                                            const ClosestKey* closest_keys, ClosestKey* surface_keys) {
   const int pixel = globalThread();
   if (pixel >= model.pixels()) return;
   forEachOffer(pixel, model, scan, projection, scan_from_model, fusion,
                [&](int target, float range, float observed_at, uint32_t source) {
                  if (onClosestSurface(range, closestWinsRange(closest_keys[target]), fusion.same_surface_distance)) {
-                   atomicMin(&pixel_keys[target], oldestWinsKey(observed_at, source));
+                   atomicMin(&surface_keys[target], oldestWinsKey(observed_at, source));
                  }
                });
 }
 
-__global__ void takeFusedWinners(const ClosestKey* pixel_keys, DeviceModelImage model, DeviceScan scan,
-                                 Rigid3f scan_from_model, DeviceModelImage fused) {
+// Both rounds are over: each pixel's keys are read here by its own thread alone, which clears them.
+__global__ void takeFusedWinners(ClosestKey* closest_keys, ClosestKey* surface_keys, DeviceModelImage model,
+                                 DeviceScan scan, Rigid3f scan_from_model, DeviceModelImage fused) {
   const int pixel = globalThread();
   if (pixel >= fused.pixels()) return;
-  const ClosestKey key = pixel_keys[pixel];
+  const ClosestKey key = surface_keys[pixel];
+  closest_keys[pixel] = kNoClosestKey;
+  surface_keys[pixel] = kNoClosestKey;
   if (key == kNoClosestKey) {
     fused.ranges[pixel] = 0.0f;
     fused.normals[pixel] = Float3{0.0f, 0.0f, 0.0f};
@@ -95,17 +99,16 @@ __global__ void copyJoiningPixels(DeviceScan scan, DeviceModelImage model) {
 
 void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, const SphericalProjection& projection,
                         const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
-                        ClosestKey* pixel_keys, const DeviceModelImage& fused, cudaStream_t stream) {
+                        ClosestKey* surface_keys, const DeviceModelImage& fused, cudaStream_t stream) {
   const int pixels = model.pixels();
-  check(cudaMemsetAsync(closest_keys, 0xff, sizeof(ClosestKey) * pixels, stream), "clearing the closest keys");
-  check(cudaMemsetAsync(pixel_keys, 0xff, sizeof(ClosestKey) * pixels, stream), "clearing the pixel keys");
   offerClosest<<<blocksFor(pixels), kThreads, 0, stream>>>(model, scan, projection, scan_from_model, fusion,
                                                            closest_keys);
   checkLaunch("offerClosest");
   offerOldestOnClosestSurface<<<blocksFor(pixels), kThreads, 0, stream>>>(model, scan, projection, scan_from_model,
-                                                                          fusion, closest_keys, pixel_keys);
+                                                                          fusion, closest_keys, surface_keys);
   checkLaunch("offerOldestOnClosestSurface");
-  takeFusedWinners<<<blocksFor(pixels), kThreads, 0, stream>>>(pixel_keys, model, scan, scan_from_model, fused);
+  takeFusedWinners<<<blocksFor(pixels), kThreads, 0, stream>>>(closest_keys, surface_keys, model, scan,
+                                                               scan_from_model, fused);
   checkLaunch("takeFusedWinners");
 }
 
