@@ -1,5 +1,5 @@
 // Sec. III-C.2 and III-D on the GPU: BEV maps that keep in each cell the oldest point on the surface
-// closest to the sensor (the two rounds of model_update.hpp), and the normals of the BEV model.
+// closest to the sensor (the two rounds of model_update.hpp).
 //
 // Order of the compact points. The CPU backend offers sources one at a time (fillGroundMap()): a cell
 // takes the next slot when it is first offered a point. Here every source offers itself to its cell
@@ -214,17 +214,6 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
   }
 }
 
-// One thread per model point: its patch search (groundNormal()) stops after a ring or two, a chain of
-// dependent loads that the GPU hides only with many threads in flight (kWideGridBlocks). Copying each
-// thread's whole patch to shared memory first loaded every cell of it, and was slower.
-__global__ void groundNormals(DeviceBev model, BevProjection projection, int wanted, int patch_radius,
-                              Float3* normals) {
-  const int count = *model.count;
-  for (int point = globalThread(); point < count; point += gridThreads()) {
-    normals[point] = groundNormal(model, projection, point, wanted, patch_radius);
-  }
-}
-
 }  // namespace
 
 size_t compactionTiles(size_t sources) { return (sources + kThreads - 1) / kThreads; }
@@ -252,12 +241,6 @@ void clearGroundMap(const DeviceBev& map, cudaStream_t stream) {
   clearCells<<<kGridStrideBlocks, kThreads, 0, stream>>>(map);
   checkLaunch("clearCells");
   check(cudaMemsetAsync(map.count, 0, sizeof(int), stream), "clearing a ground map's count");
-}
-
-void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
-                      Float3* normals, cudaStream_t stream) {
-  groundNormals<<<kWideGridBlocks, kThreads, 0, stream>>>(model, projection, wanted, patch_radius, normals);
-  checkLaunch("groundNormals");
 }
 
 }  // namespace elo::cuda

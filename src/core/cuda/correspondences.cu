@@ -6,6 +6,8 @@
 // and writes the totals straight into the host's pinned memory: no second kernel and no copy. The
 // grid is fixed (kReductionBlocks per term) and no floating-point value goes through an atomic, so the
 // sums are the same on every run and every GPU.
+#include <cuda/atomic>
+
 #include "core/common/point_to_plane.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
@@ -23,6 +25,14 @@ constexpr int kTotalRows = kTerms * kPartialRows;
 constexpr int kRowsPerWarp = (kTotalRows + kWarps - 1) / kWarps;
 static_assert(kReductionBlocks % 32 == 0, "a warp adds a row of partials, every lane as many");
 static_assert(kPartialRows <= kThreads, "a block writes each of its partial's rows with one thread");
+
+__device__ float relaxedLoad(float& value) {
+  return ::cuda::atomic_ref<float, ::cuda::thread_scope_device>(value).load(::cuda::memory_order_relaxed);
+}
+
+__device__ void relaxedStore(float& target, float value) {
+  ::cuda::atomic_ref<float, ::cuda::thread_scope_device>(target).store(value, ::cuda::memory_order_relaxed);
+}
 
 struct ThreadSums {
   double values[kTermValues];
@@ -73,6 +83,27 @@ __device__ void addNongroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
   }
 }
 
+// The normal of model ground point `match`, fitted on first use and cached for the model's lifetime (its
+// epoch), as the CPU backend's cache does: a scan matches a small part of the model's ground points, and
+// fitting all of them at every update cost more than the sums. The fit is groundNormal() of the same map
+// whoever runs it, so every thread gets the same bits; two threads fitting one point at once store the
+// same values. The normal is stored before its epoch is released, and read only after the epoch is
+// acquired.
+__device__ Float3 cachedGroundNormal(const LinearizeInputs& in, int32_t match) {
+  const GroundNormalCache& cache = in.ground_normals;
+  ::cuda::atomic_ref<unsigned, ::cuda::thread_scope_device> epoch(cache.epochs[match]);
+  float* stored = &cache.normals[match].x;
+  if (epoch.load(::cuda::memory_order_acquire) == cache.epoch) {
+    return {relaxedLoad(stored[0]), relaxedLoad(stored[1]), relaxedLoad(stored[2])};
+  }
+  const Float3 normal = groundNormal(in.model_ground, in.bev, match, in.normal_neighbours, in.patch_radius);
+  relaxedStore(stored[0], normal.x);
+  relaxedStore(stored[1], normal.y);
+  relaxedStore(stored[2], normal.z);
+  epoch.store(cache.epoch, ::cuda::memory_order_release);
+  return normal;
+}
+
 __device__ void addGroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
   const int count = *in.scan_ground.count;
   for (int i = globalThread(); i < count; i += gridThreads()) {
@@ -83,7 +114,7 @@ __device__ void addGroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
                      match)) {
       continue;
     }
-    const Float3 normal = in.model_ground_normals[match];
+    const Float3 normal = cachedGroundNormal(in, match);
     if (isZero(normal)) continue;
     sums.add(pointToPlane(moved, in.model_ground.vertices[match], normal, in.kernel_scale));
   }

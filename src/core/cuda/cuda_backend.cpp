@@ -99,6 +99,7 @@ void CudaBackend::allocate() {
     model_ground_[buffer].allocate(cells_, cells_);  // one point per cell at most
   }
   model_ground_normals_.reserve(cells_);
+  model_ground_normal_epochs_.reserve(cells_);
   // A fusion's sources are the model's points (at most one per cell) and the scan's (at most one per pixel).
   const size_t sources = cells_ + pixels_;
   cell_keys_.reserve(cells_);
@@ -138,6 +139,7 @@ void CudaBackend::clearDevice() {
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
+  clear(model_ground_normal_epochs_, cells_, 0, stream);  // epoch 0: no normal fitted
   // linearize()'s count of the blocks done at 0, and its partial sums initialised: its last block reads
   // (and drops) the rows of a term not summed.
   clear(finished_blocks_, 1, 0, stream);
@@ -322,8 +324,9 @@ NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan,
   inputs.spherical = spherical_;
   inputs.scan_ground = scanGroundMap();
   inputs.model_ground = modelGroundMap(current_);
-  inputs.model_ground_normals = model_ground_normals_.data();
   inputs.bev = bev_;
+  inputs.ground_normals = {model_ground_normals_.data(), model_ground_normal_epochs_.data(), model_epoch_};
+  inputs.normal_neighbours = config_.bev.normal_neighbours;
   inputs.patch_radius = config_.bev.normal_patch_radius;
   inputs.gates = gates_;
   inputs.motion = toRigid3f(model_from_scan);
@@ -353,9 +356,16 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     current_ = next;
   }
   model_initialized_ = true;
-  cuda::fitGroundNormals(modelGroundMap(current_), bev_, config_.bev.normal_neighbours,
-                         config_.bev.normal_patch_radius, model_ground_normals_.data(), stream);
+  startModelEpoch();
   model_view_current_ = false;
+}
+
+// The ground normals fitted for the previous model are stale from here on.
+void CudaBackend::startModelEpoch() {
+  if (++model_epoch_ == 0) {  // wrapped: 0 means "none fitted"
+    clear(model_ground_normal_epochs_, cells_, 0, stream_.get());
+    model_epoch_ = 1;
+  }
 }
 
 void CudaBackend::resetModel() {
@@ -363,6 +373,7 @@ void CudaBackend::resetModel() {
   clear(model_image_[current_].ranges, pixels_, 0, stream);
   clear(model_image_[current_].normals, pixels_, 0, stream);
   cuda::clearGroundMap(modelGroundMap(current_), stream);
+  startModelEpoch();
   model_initialized_ = false;
   model_view_current_ = false;
 }

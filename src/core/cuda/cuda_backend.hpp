@@ -92,6 +92,7 @@ class CudaBackend final : public Backend {
   };
 
   void allocate();
+  void startModelEpoch();
   void clearDevice();
   HostCloud hostCloud(const PointCloud& cloud, bool with_times) const;
   // Uploads the points, their rings when the projection uses them and their times when `with_times`, or
@@ -147,7 +148,11 @@ class CudaBackend final : public Backend {
   // The model, twice: an update writes the buffer not in use (`1 - current_`), then switches to it.
   SphericalBuffers model_image_[2];
   BevBuffers model_ground_[2];
-  DeviceArray<Float3> model_ground_normals_;  // of the current model's points
+  // The current model's ground normals, fitted when first matched (GroundNormalCache); a new epoch for
+  // every model.
+  DeviceArray<Float3> model_ground_normals_;
+  DeviceArray<unsigned> model_ground_normal_epochs_;
+  unsigned model_epoch_ = 1;
   int current_ = 0;
   bool model_initialized_ = false;
 

@@ -86,9 +86,6 @@ void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const
                      const CellCompaction& compaction, cudaStream_t stream);
 void copyGroundMap(const DeviceBev& from, const DeviceBev& to, cudaStream_t stream);
 void clearGroundMap(const DeviceBev& map, cudaStream_t stream);
-// The normal of every model point (groundNormal() of association.hpp), into `normals`.
-void fitGroundNormals(const DeviceBev& model, const BevProjection& projection, int wanted, int patch_radius,
-                      Float3* normals, cudaStream_t stream);
 
 // model_update.cu: the non-ground model (Sec. III-D).
 // `closest_keys` and `surface_keys`, one per pixel, are scratch for the two rounds (model_update.hpp):
@@ -113,6 +110,14 @@ constexpr int kReductionBlocks = 128;
 // Rows of a block's partial sums: the packed sums, then the candidate and inlier counts.
 constexpr int kPartialRows = kTermValues + 2;
 
+// The normals of the model's ground points fitted so far (one slot per point): slot p holds point p's
+// normal when epochs[p] equals `epoch`, which changes with every model update.
+struct GroundNormalCache {
+  Float3* normals;
+  unsigned* epochs;
+  unsigned epoch;
+};
+
 struct LinearizeInputs {
   bool nonground;  // which terms to sum, at least one; a term left out sums to zero
   bool ground;
@@ -123,8 +128,9 @@ struct LinearizeInputs {
   SphericalProjection spherical;
   DeviceBev scan_ground;
   DeviceBev model_ground;
-  const Float3* model_ground_normals;
   BevProjection bev;
+  GroundNormalCache ground_normals;
+  int normal_neighbours;  // model points per ground normal (bev.normal_neighbours)
   int patch_radius;
   CorrespondenceGates gates;
   Rigid3f motion;

@@ -13,8 +13,8 @@ inline int blocksFor(int items) { return (items + kThreads - 1) / kThreads; }
 // Kernels whose item count lives on the device loop over it with a fixed grid of this many blocks, so
 // the host need not read the count first.
 constexpr int kGridStrideBlocks = 256;
-// Grid-stride kernels whose items wait on memory (atomics, searches in a map) want more threads in flight:
-// this many blocks of kThreads fill an H100 (132 SMs of 2048 threads) once.
+// Grid-stride kernels whose items wait on memory (atomics) want more threads in flight: this many blocks of
+// kThreads fill an H100 (132 SMs of 2048 threads) once.
 constexpr int kWideGridBlocks = 1024;
 
 // A bad launch (configuration, no kernel image) shows at once; a fault in a kernel shows at the next
