@@ -129,8 +129,10 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
     result.model_from_scan = expSE3(*step) * result.model_from_scan;
     const bool small = step->head<3>().norm() < config.converged_translation &&
                        step->tail<3>().norm() < config.converged_rotation;
-    if (kernel.advance(small)) {
-      if (refresh && refresh(result.model_from_scan)) continue;
+    const bool under_final_kernel = kernel.isFinal();
+    const bool converged = kernel.advance(small);
+    if (under_final_kernel && refresh && refresh(result.model_from_scan, converged)) continue;
+    if (converged) {
       result.converged = true;
       break;
     }

@@ -36,7 +36,7 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
   scan_velocity_ = deskew.velocity;
   size_t occupied = 0;
   arena_.execute([&] {
-    occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, scan_);
+    occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, placed_, scan_);
   });
   return occupied;
 }

@@ -41,6 +41,7 @@ class CpuBackend final : public Backend {
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_
   ClosestWins winners_;  // the projection's closest point per pixel
+  std::vector<ScanPoint> placed_;  // the projection's cloud points as placed (corrected, deskewed, timed)
   SphericalFusionScratch fusion_scratch_;
   NormalScratch normal_scratch_;
   GroundNormalCache ground_normals_;

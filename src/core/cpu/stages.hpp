@@ -10,6 +10,7 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
+#include "core/common/scan_projection.hpp"
 #include "core/cpu/closest_wins.hpp"
 #include "elo/backend.hpp"
 #include "elo/sensor_model.hpp"
@@ -18,10 +19,11 @@ namespace elo::cpu {
 
 // projection.cpp: the closest point of the cloud per pixel, every point deskewed by `deskew` first;
 // `ring_rows` maps a driver's ring index to its row (empty: rows from the elevation). `winners` must be
-// empty, as resize() leaves it, and is left empty. Returns the number of occupied pixels.
+// empty, as resize() leaves it, and is left empty. `placed` is scratch: each cloud point as placed.
+// Returns the number of occupied pixels.
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
-                    ScanImage& scan);
+                    std::vector<ScanPoint>& placed, ScanImage& scan);
 
 // deskew.cpp: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
 void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
