@@ -150,22 +150,16 @@ struct SweepDeskew {
 };
 
 // A projected pixel deskewed again under `velocity` after it was under `applied`: the vertex from the
-// point as measured, the normal turned with it. Deskewing changes a normal's window as a whole (its
-// points were fired within a fraction of a millisecond of each other), so turning the normal is what
-// estimating it again would give. It turns by R(t w) R(t w_applied)^T, to first order by t (w - w_applied);
-// turned so and normalised, it is off by at most t^2 |w| |w - w_applied| / 2 (the two turns' axes differ)
-// and (t |w - w_applied|)^3 / 3: under 1e-4 rad half a 10 Hz sweep from the reference, at up to 1 rad/s
-// after a change of 0.05 rad/s (a refinement round) or from rest (the first scan of a start), far below
-// a normal's own error, for a third of the exact turn's arithmetic.
+// point as measured, the normal turned back to the firing frame and forward again. Deskewing changes a
+// normal's window as a whole (its points were fired within a fraction of a millisecond of each other), so
+// turning the normal is what estimating it again would give.
 ELO_HOST_DEVICE inline void redeskewPixel(const SweepVelocity& applied, const SweepVelocity& velocity,
                                           const Float3& measured, float time, Float3& vertex, float& range,
                                           Float3& normal) {
   const TwistCoefficients k = coefficientsAt(velocity, time);
   vertex = rotateAt(velocity, time, k, measured) + translationAt(velocity, time, k);
   range = norm(vertex);
-  if (isZero(normal)) return;
-  const Float3 turned = normal + cross(velocity.angular - applied.angular, normal) * time;
-  normal = turned * (1.0f / norm(turned));
+  if (!isZero(normal)) normal = rotateAt(velocity, time, k, deskewDirection(applied, -time, normal));
 }
 
 }  // namespace elo
