@@ -243,7 +243,8 @@ void validate(const Config& c) {
   require(r.max_correspondence_distance > 0.0, "registration.max_correspondence_distance", "must be positive");
   require(r.max_normal_angle_deg > 0.0 && r.max_normal_angle_deg <= 180.0, "registration.max_normal_angle_deg",
           "must lie in (0, 180]");
-  require(r.association_radius >= 0, "registration.association_radius", "must not be negative");
+  require(r.association_radius >= 0 && r.association_radius <= s.image_width / 2, "registration.association_radius",
+          "must lie in [0, sensor.image_width / 2]");
   require(r.robust_kernel_scale >= 0.0, "registration.robust_kernel_scale", "must not be negative");
   // The six scaled eigenvalues sum to 2, so the smallest is at most 1/3: a threshold that high would find
   // every scan degenerate.

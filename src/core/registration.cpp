@@ -1,6 +1,7 @@
 #include "elo/registration.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 namespace elo {
@@ -104,6 +105,32 @@ std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const V
   return constrainedStep(result.degeneracy, result.hessian, gradient);
 }
 
+// The size of a Gauss-Newton step: its translation (m) and its rotation (rad).
+struct StepSize {
+  double translation;
+  double rotation;
+};
+
+// How far the steps still to come move the estimate, after a step of size `now` that followed one of
+// size `before` on the same cost: reweighted Gauss-Newton converges linearly, each step a fraction
+// rho = now / before of the one before, so the steps to come sum to now rho / (1 - rho). Infinite while
+// the steps do not shrink (and with no step before, `before` = 0).
+double remainingAfter(double now, double before) { return now < before ? now * now / (before - now) : INFINITY; }
+
+// A component of the motion (translation or rotation) has converged when its step was below the
+// tolerance, or when the steps still to come, predicted from how fast the last two shrank, are. A scan
+// that converges fast then stops a step earlier; where the steps shrink slowly (rho above 1/2, the
+// prediction exceeds the step itself) it stops on the step alone, as without the prediction.
+bool componentConverged(double now, double before, double tolerance) {
+  return now < tolerance || remainingAfter(now, before) < tolerance;
+}
+
+bool hasConverged(const StepSize& step, const std::optional<StepSize>& previous, const RegistrationConfig& config) {
+  const StepSize before = previous.value_or(StepSize{0.0, 0.0});
+  return componentConverged(step.translation, before.translation, config.converged_translation) &&
+         componentConverged(step.rotation, before.rotation, config.converged_rotation);
+}
+
 }  // namespace
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
@@ -116,6 +143,7 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
   // surfaces. Every direction is solved, as with the handling off.
   const double degeneracy_threshold = informed_guess ? config.degeneracy_threshold : 0.0;
   Vector6d g;
+  std::optional<StepSize> previous;  // the last step, while the cost (kernel and scan) stayed the same
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     result.last = backend.linearize(result.model_from_scan, kernel.scale());
     result.weight = fusionWeight(result.last, config);
@@ -127,15 +155,19 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
       return result;
     }
     result.model_from_scan = expSE3(*step) * result.model_from_scan;
-    const bool small = step->head<3>().norm() < config.converged_translation &&
-                       step->tail<3>().norm() < config.converged_rotation;
+    const StepSize size{step->head<3>().norm(), step->tail<3>().norm()};
+    const double scale = kernel.scale();
     const bool under_final_kernel = kernel.isFinal();
-    const bool converged = kernel.advance(small);
-    if (under_final_kernel && refresh && refresh(result.model_from_scan, converged)) continue;
+    const bool converged = kernel.advance(hasConverged(size, previous, config));
+    if (under_final_kernel && refresh && refresh(result.model_from_scan, converged)) {
+      previous.reset();  // the scan's points moved: the next step shrinks on another cost
+      continue;
+    }
     if (converged) {
       result.converged = true;
       break;
     }
+    previous = kernel.scale() == scale ? std::optional<StepSize>(size) : std::nullopt;
   }
   return result;
 }

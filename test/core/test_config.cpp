@@ -101,6 +101,9 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   config = Config();
   config.ground.rise_tolerance = -0.01;
   EXPECT_NE(message_of(config).find("ground.rise_tolerance"), std::string::npos);
+  config = Config();
+  config.registration.association_radius = config.sensor.image_width / 2 + 1;  // would visit columns twice
+  EXPECT_NE(message_of(config).find("registration.association_radius"), std::string::npos);
 }
 
 TEST(Config, DeskewKeysSetTheTimeSourceAndTheSweep) {

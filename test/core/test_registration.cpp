@@ -73,6 +73,73 @@ TEST(Registration, ResultsAreIdenticalForAnyThreadCount) {
   EXPECT_EQ(a.registration.iterations, b.registration.iterations);
 }
 
+// A cost whose Gauss-Newton steps shrink by a fixed ratio, as reweighted Gauss-Newton's do: every
+// linearisation asks for (1 - ratio) of the way back to the identity. The pose stays a screw motion along
+// x (translation along the rotation axis), so the steps compose exactly.
+class ShrinkingSteps : public Backend {
+ public:
+  explicit ShrinkingSteps(double ratio) : ratio_(ratio) {}
+
+  NormalEquations linearize(const Eigen::Isometry3d& model_from_scan, double) override {
+    const Eigen::AngleAxisd rotation(model_from_scan.rotation());
+    Vector6d error;
+    error << model_from_scan.translation(), rotation.angle() * rotation.axis();
+    NormalEquations sums;
+    sums.nonground.candidates = sums.nonground.inliers = 100;
+    sums.nonground.JtJ = 100.0 * Matrix6d::Identity();
+    sums.nonground.Jte = 100.0 * (1.0 - ratio_) * error;
+    ++linearizations;
+    return sums;
+  }
+
+  int linearizations = 0;
+
+  const char* name() const override { return "shrinking steps"; }
+  size_t projectScan(const PointCloud&, float, const SweepMotion&) override { return 0; }
+  void deskewScan(const Vector6d&) override {}
+  void segmentGround() override {}
+  void estimateNormals() override {}
+  void buildGroundMap() override {}
+  void updateModel(const Eigen::Isometry3d&, float) override {}
+  void resetModel() override {}
+  const ScanImage& scan() override { return scan_; }
+  const BevImage& scanGround() override { return ground_; }
+  const Model& model() override { return model_; }
+
+ private:
+  double ratio_;
+  ScanImage scan_;
+  BevImage ground_;
+  Model model_;
+};
+
+RegistrationResult registerShrinking(ShrinkingSteps& backend) {
+  RegistrationConfig config;  // stops at steps under 5e-4 m and 5e-5 rad
+  config.terms = CostTerms::spherical_nonground;
+  config.degeneracy_threshold = 0.0;
+  const Eigen::Isometry3d start = Eigen::Translation3d(0.1, 0.0, 0.0) * Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitX());
+  return registerScan(backend, start, true, config);
+}
+
+TEST(Registration, StopsWhenTheStepsStillToComeAreBelowTheTolerance) {
+  // Steps of 90, 9, 0.9 mm: after the third, the steps to come (0.1 mm; 1e-5 rad) are below the
+  // tolerance, one linearisation before a step itself is.
+  ShrinkingSteps fast(0.1);
+  const RegistrationResult fast_result = registerShrinking(fast);
+  EXPECT_TRUE(fast_result.converged);
+  EXPECT_EQ(fast_result.iterations, 3);
+  EXPECT_EQ(fast.linearizations, 3);
+  EXPECT_NEAR(fast_result.model_from_scan.translation().x(), 1e-4, 1e-9);
+  EXPECT_LT(fast_result.model_from_scan.translation().norm(), 5e-4);
+
+  // Steps shrinking by 0.6 predict more to come than the step itself: they stop on the step alone,
+  // the first under 5e-4 m (0.40 mm, the tenth) and 5e-5 rad.
+  ShrinkingSteps slow(0.6);
+  const RegistrationResult slow_result = registerShrinking(slow);
+  EXPECT_TRUE(slow_result.converged);
+  EXPECT_EQ(slow_result.iterations, 10);
+}
+
 TEST(FusionWeight, FollowsTheInlierRatios) {
   RegistrationConfig config;
   NormalEquations sums;

@@ -13,6 +13,7 @@
 #include "core/common/normals.hpp"
 #include "core/common/point_to_plane.hpp"
 #include "core/cpu/image_views.hpp"
+#include "core/cpu/packed_sums.hpp"
 #include "elo/backend.hpp"
 
 namespace elo {
@@ -160,6 +161,31 @@ TEST(PointToPlane, ResidualJacobianAndGemanMcClureWeight) {
   for (int i = 0; i < 6; ++i) EXPECT_EQ(term.jacobian[i], expected[i]);
   EXPECT_DOUBLE_EQ(gemanMcClureWeight(0.0, 0.1), 1.0);
   EXPECT_DOUBLE_EQ(gemanMcClureWeight(0.1, 0.1), 0.25);  // (s^2 / (s^2 + e^2))^2 at e = s
+}
+
+// The CPU's 4-wide accumulator adds each packed value the same products in the same order as the shared
+// scalar one, so its sums are the same bit for bit.
+TEST(PackedSums, TheCpusLaneSumsEqualTheSharedScalarSumsBitForBit) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f);
+  std::uniform_real_distribution<float> offset(-0.2f, 0.2f);
+  double scalar[kTermValues] = {};
+  cpu::LaneSums lanes;
+  for (int i = 0; i < 1000; ++i) {
+    const Float3 moved{coordinate(random), coordinate(random), coordinate(random)};
+    const Float3 vertex = moved + Float3{offset(random), offset(random), offset(random)};
+    const Float3 tilted{offset(random), offset(random), 1.0f};
+    const Float3 normal = tilted / norm(tilted);
+    const PointToPlane term = pointToPlane(moved, vertex, normal, 0.1);
+    addToPackedSums(term, scalar);
+    lanes.add(term);
+  }
+  double from_lanes[kTermValues];
+  lanes.copyTo(from_lanes);
+  for (int v = 0; v < kTermValues; ++v) {
+    EXPECT_NE(scalar[v], 0.0) << "value " << v;
+    EXPECT_EQ(from_lanes[v], scalar[v]) << "value " << v;
+  }
 }
 
 // Normals of the CPU backend's and of windowNormal() / crossProductNormal() over the same scan.

@@ -28,20 +28,28 @@ struct CorrespondenceGates {
   }
 };
 
-// Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
-// otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
-// within `radius` pixels; -1 when there is none.
+// Column `col` of an image `cols` wide that closes on itself in azimuth, for col in [-cols, 2 cols):
+// validate() keeps the association radius within half the image's width. A compare, not an integer
+// division (a modulo per searched pixel cost more than the rest of the search).
+ELO_HOST_DEVICE inline int wrappedColumn(int col, int cols) {
+  if (col < 0) return col + cols;
+  return col >= cols ? col - cols : col;
+}
+
+namespace detail {
+
+// The model pixel with a normal nearest to `moved` within `radius` pixels of (row, col); -1 when none.
 template <typename SphericalModel>
-ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3& moved, int row, int col, int radius) {
-  const int projected = row * model.cols + col;
-  if (model.matchable(projected)) return projected;
+ELO_HOST_DEVICE int nearestModelPixelAround(const SphericalModel& model, const Float3& moved, int row, int col,
+                                            int radius) {
   int best = -1;
   float best_distance = INFINITY;
   const int first_row = row - radius < 0 ? 0 : row - radius;
   const int last_row = row + radius > model.rows - 1 ? model.rows - 1 : row + radius;
   for (int r = first_row; r <= last_row; ++r) {
+    const int row_start = r * model.cols;
     for (int dc = -radius; dc <= radius; ++dc) {
-      const int pixel = r * model.cols + (col + dc + model.cols) % model.cols;
+      const int pixel = row_start + wrappedColumn(col + dc, model.cols);
       if (!model.matchable(pixel)) continue;
       const float distance = squaredDistance(model.vertex(pixel), moved);
       if (distance < best_distance) {
@@ -51,6 +59,19 @@ ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3&
     }
   }
   return best;
+}
+
+}  // namespace detail
+
+// Projective association (Eq. 7-8): the model pixel that `moved` projects to, when it has a normal;
+// otherwise, since uneven beams leave rows empty, the model pixel with a normal nearest to `moved`
+// within `radius` pixels; -1 when there is none. (The search is a function of its own so that the
+// common case, the projected pixel, stays inline in the caller's loop.)
+template <typename SphericalModel>
+ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3& moved, int row, int col, int radius) {
+  const int projected = row * model.cols + col;
+  if (model.matchable(projected)) return projected;
+  return detail::nearestModelPixelAround(model, moved, row, col, radius);
 }
 
 // The non-ground correspondence of scan vertex `vertex` (normal `normal`) under `motion`: the moved point
@@ -68,19 +89,34 @@ ELO_HOST_DEVICE bool nongroundMatch(const SphericalProjection& projection, const
   return !(dot(motion.rotate(normal), model.normal(match)) < gates.min_normal_cosine);
 }
 
-// Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`.
+namespace detail {
+
+template <typename GroundMap, typename Visit>
+ELO_HOST_DEVICE void visitCell(const GroundMap& map, int cell, Visit& visit) {
+  const int32_t point = map.pointOfCell(cell);
+  if (point >= 0) visit(point);
+}
+
+}  // namespace detail
+
+// Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`,
+// row by row and, within a row, column by column.
 template <typename GroundMap, typename Visit>
 ELO_HOST_DEVICE void forEachPointOnRing(const GroundMap& map, const BevProjection& projection, int row, int col,
                                         int ring, Visit& visit) {
   const int first_row = row - ring < 0 ? 0 : row - ring;
   const int last_row = row + ring > projection.rows - 1 ? projection.rows - 1 : row + ring;
+  const int left = col - ring;  // the ring's two columns; either may lie outside the grid
+  const int right = col + ring;
+  const int first_col = left < 0 ? 0 : left;
+  const int last_col = right > projection.cols - 1 ? projection.cols - 1 : right;
   for (int r = first_row; r <= last_row; ++r) {
-    const bool edge_row = r == row - ring || r == row + ring;
-    const int step = edge_row || ring == 0 ? 1 : 2 * ring;  // inner rows: only the ring's two ends
-    for (int c = col - ring; c <= col + ring; c += step) {
-      if (c < 0 || c >= projection.cols) continue;
-      const int32_t point = map.pointOfCell(r * projection.cols + c);
-      if (point >= 0) visit(point);
+    const int row_start = r * projection.cols;
+    if (r == row - ring || r == row + ring) {  // the ring's top and bottom rows: every cell
+      for (int c = first_col; c <= last_col; ++c) detail::visitCell(map, row_start + c, visit);
+    } else {  // rows in between: only the ring's two ends
+      if (left >= 0) detail::visitCell(map, row_start + left, visit);
+      if (right < projection.cols) detail::visitCell(map, row_start + right, visit);
     }
   }
 }
@@ -102,6 +138,19 @@ struct NearestOnRing {
     }
   }
 };
+
+// The point of `map` nearest to `point` in the first ring of cells around (row, col), from ring 1 up to
+// `radius`, that holds any; -1 when none does.
+template <typename GroundMap>
+ELO_HOST_DEVICE int32_t nearestGroundPointOnRings(const GroundMap& map, const BevProjection& projection,
+                                                  const Float3& point, int row, int col, int radius) {
+  for (int ring = 1; ring <= radius; ++ring) {
+    NearestOnRing<GroundMap> nearest{map, point};
+    forEachPointOnRing(map, projection, row, col, ring, nearest);
+    if (nearest.best >= 0) return nearest.best;
+  }
+  return -1;
+}
 
 // Upper bound of bev.normal_neighbours (validate() enforces it), the size of the fit's fixed buffers.
 constexpr int kMaxNormalNeighbours = 32;
@@ -141,15 +190,14 @@ struct NearestPoints {
 
 // The point of `map` nearest to `point` in the cell of (row, col), or else in the first ring of cells
 // around it that holds any, up to `radius` rings out; -1 when there is none.
+// (The ring search is a function of its own so that the common case, a point in the cell itself, stays
+// inline in the caller's loop.)
 template <typename GroundMap>
 ELO_HOST_DEVICE int32_t nearestGroundPoint(const GroundMap& map, const BevProjection& projection, const Float3& point,
                                            int row, int col, int radius) {
-  for (int ring = 0; ring <= radius; ++ring) {
-    detail::NearestOnRing<GroundMap> nearest{map, point};
-    forEachPointOnRing(map, projection, row, col, ring, nearest);
-    if (nearest.best >= 0) return nearest.best;
-  }
-  return -1;
+  const int32_t in_cell = map.pointOfCell(row * projection.cols + col);  // ring 0: the one point it may hold
+  if (in_cell >= 0) return in_cell;
+  return detail::nearestGroundPointOnRings(map, projection, point, row, col, radius);
 }
 
 // The ground correspondence of scan ground vertex `vertex` under `motion` (Eq. 16): the model point in

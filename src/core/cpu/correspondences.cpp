@@ -6,6 +6,7 @@
 #include "core/common/point_to_plane.hpp"
 #include "core/common/term_sums.hpp"
 #include "core/cpu/image_views.hpp"
+#include "core/cpu/packed_sums.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
 
@@ -15,21 +16,25 @@ namespace {
 
 // The sums of one block of correspondences, packed (point_to_plane.hpp).
 struct PackedSums {
-  double values[kTermValues] = {};
+  LaneSums values;
   int candidates = 0;
   int inliers = 0;
 
   void add(const PointToPlane& term) {
-    addToPackedSums(term, values);
+    values.add(term);
     ++inliers;
   }
   PackedSums& operator+=(const PackedSums& other) {
-    for (int v = 0; v < kTermValues; ++v) values[v] += other.values[v];
+    values += other.values;
     candidates += other.candidates;
     inliers += other.inliers;
     return *this;
   }
-  TermSums unpacked() const { return unpackTermSums(values, candidates, inliers); }
+  TermSums unpacked() const {
+    double packed[kTermValues];
+    values.copyTo(packed);
+    return unpackTermSums(packed, candidates, inliers);
+  }
 };
 
 }  // namespace
@@ -49,7 +54,8 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(config);
   const ModelPixels model_pixels(model);
   const SphericalImage& image = scan.image;
-  return deterministicSum<PackedSums>(pixels.size(), [&](size_t begin, size_t end, PackedSums& sums) {
+  return deterministicSum<PackedSums>(pixels.size(), [&](size_t begin, size_t end, PackedSums& block_sums) {
+    PackedSums sums;  // a local, so that the sums stay in registers over the loop
     for (size_t i = begin; i < end; ++i) {
       const int32_t pixel = pixels[i];
       ++sums.candidates;
@@ -61,6 +67,7 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
       }
       sums.add(pointToPlane(moved, model_pixels.vertex(match), model_pixels.normal(match), kernel_scale));
     }
+    block_sums = sums;
   }).unpacked();
 }
 
@@ -70,7 +77,8 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
   const Rigid3f motion = toRigid3f(model_from_scan);
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(registration);
   const GroundPoints model_points(model);
-  return deterministicSum<PackedSums>(scan_ground.size(), [&](size_t begin, size_t end, PackedSums& sums) {
+  return deterministicSum<PackedSums>(scan_ground.size(), [&](size_t begin, size_t end, PackedSums& block_sums) {
+    PackedSums sums;
     for (size_t i = begin; i < end; ++i) {
       ++sums.candidates;
       Float3 moved;
@@ -83,6 +91,7 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
       if (isZero(normal)) continue;
       sums.add(pointToPlane(moved, model_points.vertex(match), normal, kernel_scale));
     }
+    block_sums = sums;
   }).unpacked();
 }
 
