@@ -43,7 +43,7 @@ options:
                        (default 1); score it against every K-th ground-truth pose
   --reverse            play the scans last to first, the route driven backwards (stamps mirrored
                        so time still advances); elo_eval --reverse compares it with a forward run
-  --timing CSV         per-frame stage times, iterations, inlier counts and degeneracy
+  --timing CSV         per-frame stage times, iterations, deskew rounds, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
   --strict             stop at the first scan that cannot be read and exit 1 (after writing the
@@ -251,9 +251,10 @@ class Report {
 void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {
   csv << index << ',' << stamp << ',' << (r.processed ? 1 : 0) << ',' << r.times.projection << ','
       << r.times.feature_extraction << ',' << r.times.registration << ',' << r.times.model_update << ','
-      << r.times.total << ',' << r.registration.iterations << ',' << r.registration.last.nonground.inliers << ','
-      << r.registration.last.ground.inliers << ',' << r.registration.weight << ','
-      << r.registration.degeneracy.eigenvalues[0] << ',' << r.registration.degeneracy.describe() << '\n';
+      << r.times.total << ',' << r.registration.iterations << ',' << r.deskew_rounds << ','
+      << r.registration.last.nonground.inliers << ',' << r.registration.last.ground.inliers << ','
+      << r.registration.weight << ',' << r.registration.degeneracy.eigenvalues[0] << ','
+      << r.registration.degeneracy.describe() << '\n';
 }
 
 void showProgress(size_t done, size_t total) {
@@ -289,7 +290,7 @@ class ScanLoop {
     timing_.open(options.timing_csv);
     if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
     timing_ << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
-               "iterations,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
+               "iterations,deskew_rounds,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
   }
 
   // Reads each scan one ahead and prefetches it before processing the one before it, so that a device

@@ -146,9 +146,10 @@ struct DeskewConfig {
   // `field` is what ROS drivers deliver: Velodyne `time`, Ouster `t`, Hesai `timestamp`. A cloud without
   // usable times is processed as instantaneous, and counted (Odometry::warningCounts()).
   TimeSource time_source = TimeSource::field;
-  // After the first registration (deskewed with the motion prior's velocity), each round deskews again
-  // with the registered motion and registers again from the registered pose. One round brings the
-  // deskew to the registered motion; further rounds change it by what one round changed the pose,
+  // Refinement rounds within the registration: after each of its first Gauss-Newton steps, the scan
+  // (deskewed under the last registered velocity) is deskewed again under the motion estimated so far
+  // and the iterations go on. One round brings the deskew to the registered motion at no iterations of
+  // its own (after the first step); further rounds change it by what one round changed the pose,
   // which is the prior's error times the sweep over the scan interval (docs/deskew.md).
   int rounds = 1;
 };

@@ -44,6 +44,11 @@ ELO_HOST_DEVICE inline float norm(const Float3& a) { return std::sqrt(squaredNor
 ELO_HOST_DEVICE inline float squaredDistance(const Float3& a, const Float3& b) { return squaredNorm(a - b); }
 // Normals are unit vectors or exactly zero ("no normal").
 ELO_HOST_DEVICE inline bool isZero(const Float3& a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+// `condition ? a : b`, component by component: a select the CPU's loops vectorise (a choice between
+// whole structs is a choice between their addresses, which does not).
+ELO_HOST_DEVICE inline Float3 choose(bool condition, const Float3& a, const Float3& b) {
+  return {condition ? a.x : b.x, condition ? a.y : b.y, condition ? a.z : b.z};
+}
 ELO_HOST_DEVICE inline bool isFinite(const Float3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }

@@ -106,15 +106,19 @@ class Odometry {
   double secondsSinceFirst(double stamp) const;
   // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
   void followTimeline(double stamp, FrameResult& result);
-  // Registers the projected scan from `guess`; each time the registration converges, deskews the scan
-  // again under the registered motion and lets the registration go on, up to deskew.rounds times and
-  // while that changes the deskew by more than a converged step over the sweep (`farthest` seconds
-  // either side of the reference; changesRegistration()). Against a provisional model the scan is
-  // deskewed once, for the model, and the registration ends (docs/deskew.md).
+  // Registers the projected scan from `guess`. After each Gauss-Newton step under the final kernel, up to
+  // deskew.rounds times, it deskews the scan again under the motion estimated so far and lets the
+  // iterations go on, when that changes the deskew by more than a converged step over the sweep
+  // (`farthest` seconds either side of the reference; changesRegistration()): a round after the first
+  // step, when the estimate is already close, costs no iterations of its own, where a round after
+  // convergence cost about three to converge again. Against a provisional model the scan is deskewed
+  // once, for the model, after the registration converges (docs/deskew.md).
   // `deskewed`: the velocity the projection deskewed the scan under; returns the one it ends deskewed
   // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
   Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
                              FrameResult& result);
+  // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
+  void deskewScanAgain(const Vector6d& velocity, FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;

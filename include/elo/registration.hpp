@@ -54,10 +54,13 @@ class KernelSchedule {
   double scale_;
 };
 
-// Called when the registration has converged at `model_from_scan`: it may move the scan's points (deskew
-// them again under the motion just registered, docs/deskew.md) and return true, and the registration
-// then goes on from there until it converges again; false ends the registration.
-using ScanRefresh = std::function<bool(const Eigen::Isometry3d& model_from_scan)>;
+// Offered the estimate `model_from_scan` after every Gauss-Newton step taken under the final kernel scale,
+// before that step's convergence ends the registration (`converged`): it may move the scan's points
+// (deskew them again under the motion estimated so far, docs/deskew.md) and return true, and the
+// registration goes on from there until a step converges; false leaves the registration as it was.
+// Offered before convergence, a refresh costs no iterations of its own: the steps still to come serve
+// both the estimate and the moved points.
+using ScanRefresh = std::function<bool(const Eigen::Isometry3d& model_from_scan, bool converged)>;
 
 // `informed_guess`: the initial guess comes from a motion model with enough history to trust it. The
 // steps then solve only the directions the scan constrains (see degeneracy.hpp); along the others the

@@ -181,7 +181,7 @@ std::vector<Parameter> parameters(Config& c) {
                  "per-point firing times for motion compensation: none (instantaneous scans), field (the cloud's "
                  "times, relative to its stamp), azimuth (from each point's azimuth; reference mid-sweep)"),
       bindField("deskew.rounds", c.deskew.rounds,
-                "deskew-and-register rounds after the first registration, each with the motion just registered"),
+                "rounds of deskewing again under the motion estimated so far, one after each of the registration's first Gauss-Newton steps"),
       bindChoice("runtime.backend", c.runtime.backend,
                  {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
       bindField("runtime.backend_fallback", c.runtime.backend_fallback,

@@ -64,26 +64,31 @@ FrameResult Odometry::skip(const std::string& reason) {
   return result;
 }
 
+void Odometry::deskewScanAgain(const Vector6d& velocity, FrameResult& result) {
+  const auto deskew_start = Clock::now();
+  backend_->deskewScan(velocity);
+  backend_->buildGroundMap();
+  backend_->synchronize();
+  result.times.deskew += millisecondsSince(deskew_start);
+  ++result.deskew_rounds;
+}
+
 Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed,
                                      double farthest, FrameResult& result) {
   Vector6d deskewed_under = deskewed;
-  const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& registered) {
+  const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& estimate, bool converged) {
     if (result.time_source == TimeSource::none) return false;
-    // The scan that replaces a provisional model is deskewed for it whatever deskew.rounds says.
+    // Against a model of the first scan as measured, the scan as measured registers best (the two are
+    // bent alike): it is deskewed once, whatever deskew.rounds says, when the registration has converged,
+    // only to replace that model.
+    if (model_provisional_ && !converged) return false;
     const int rounds = model_provisional_ ? 1 : config_.deskew.rounds;
-    const Vector6d velocity = sweepVelocity(registered, dt);
+    const Vector6d velocity = sweepVelocity(estimate, dt);
     if (result.deskew_rounds >= rounds || !changesRegistration(deskewed_under, velocity, farthest, config_.registration)) {
       return false;
     }
-    const auto deskew_start = Clock::now();
-    backend_->deskewScan(velocity);
-    backend_->buildGroundMap();
-    backend_->synchronize();
-    result.times.deskew += millisecondsSince(deskew_start);
+    deskewScanAgain(velocity, result);
     deskewed_under = velocity;
-    ++result.deskew_rounds;
-    // Against a model of the first scan as measured, the scan as measured registers best (the two are
-    // bent alike): deskewed, it only replaces that model.
     return !model_provisional_;
   };
   const auto stage_start = Clock::now();

@@ -157,9 +157,13 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
     result.model_from_scan = expSE3(*step) * result.model_from_scan;
     const StepSize size{step->head<3>().norm(), step->tail<3>().norm()};
     const double scale = kernel.scale();
-    if (kernel.advance(hasConverged(size, previous, config))) {
-      previous.reset();
-      if (refresh && refresh(result.model_from_scan)) continue;
+    const bool under_final_kernel = kernel.isFinal();
+    const bool converged = kernel.advance(hasConverged(size, previous, config));
+    if (under_final_kernel && refresh && refresh(result.model_from_scan, converged)) {
+      previous.reset();  // the scan's points moved: the next step shrinks on another cost
+      continue;
+    }
+    if (converged) {
       result.converged = true;
       break;
     }

@@ -7,6 +7,7 @@
 #include "analytic_scene.hpp"
 #include "core/common/deskew.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/cpu/stages.hpp"
 #include "elo/deskew.hpp"
 #include "elo/odometry.hpp"
 
@@ -96,6 +97,54 @@ TEST(Deskew, AzimuthTimesFollowKittisConvention) {
 
 // The sweep of a moving sensor, deskewed, is what an instantaneous sensor at the reference pose sees:
 // each vertex lies on the scene where a ray from the reference pose through it meets the scene.
+// The CPU's pass over the pixels (a vectorised loop where every pixel turns little, the per-pixel
+// function elsewhere) gives every pixel exactly what redeskewPixel() gives it, the function the CUDA
+// kernel runs per pixel: on a scan turning little, one turning fast, and one whose third block holds
+// points far enough from the reference to need the exact coefficients. Empty pixels, with a past scan's
+// point and time left in them, stay empty, as does a block without points (the fourth).
+TEST(Deskew, TheCpuPassOverPixelsGivesEachPixelThePerPixelMath) {
+  ScanImage before;
+  before.resize(4, 1024);  // a block of the pass per row
+  const size_t pixels = before.image.pixelCount();
+  for (size_t pixel = 0; pixel < pixels; ++pixel) {
+    const float x = 0.001f * static_cast<float>(pixel);
+    before.measured[pixel] =
+        Eigen::Vector3f(3.0f + 40.0f * std::sin(x), 30.0f * std::cos(1.3f * x), -1.7f + std::sin(7.0f * x));
+    // Rows 0 and 1 within half a sweep of the reference; row 2 out to two sweeps, as `field` times may be.
+    before.time[pixel] = (pixel < 2048 ? 0.05f : 0.2f) * std::sin(3.1f * x);
+    before.image.vertex[pixel] = before.measured[pixel];
+    const bool empty = pixel % 7 == 3 || pixel >= 3072;
+    before.image.range[pixel] = empty ? 0.0f : before.measured[pixel].norm();
+    const Eigen::Vector3f normal = Eigen::Vector3f(std::sin(x), std::cos(x), 0.3f).normalized();
+    before.image.normal[pixel] = pixel % 5 == 0 || empty ? Eigen::Vector3f::Zero() : normal;
+  }
+  Vector6d fast_turn;
+  fast_turn << 12.0, -3.0, 0.5, 3.6, -2.4, 12.0;
+  const std::pair<Vector6d, Vector6d> cases[] = {{0.7 * drivingVelocity(), drivingVelocity()},
+                                                 {drivingVelocity(), fast_turn}};
+  for (const auto& [applied_twist, twist] : cases) {
+    const SweepVelocity applied = toSweepVelocity(applied_twist);
+    const SweepVelocity velocity = toSweepVelocity(twist);
+    ScanImage scan = before;
+    cpu::deskewScan(applied, velocity, scan);
+    for (size_t pixel = 0; pixel < pixels; ++pixel) {
+      if (!before.image.occupied(pixel)) {
+        ASSERT_EQ(scan.image.range[pixel], 0.0f) << pixel;
+        ASSERT_TRUE(scan.image.normal[pixel].isZero()) << pixel;
+        ASSERT_EQ(scan.image.vertex[pixel], before.image.vertex[pixel]) << pixel;
+        continue;
+      }
+      Float3 vertex;
+      float range = 0.0f;
+      Float3 normal = toFloat3(before.image.normal[pixel]);
+      redeskewPixel(applied, velocity, toFloat3(before.measured[pixel]), before.time[pixel], vertex, range, normal);
+      ASSERT_EQ(scan.image.vertex[pixel], toVec3f(vertex)) << pixel;
+      ASSERT_EQ(scan.image.range[pixel], range) << pixel;
+      ASSERT_EQ(scan.image.normal[pixel], toVec3f(normal)) << pixel;
+    }
+  }
+}
+
 class MovingSweep : public ::testing::TestWithParam<TimeSource> {
  protected:
   void SetUp() override {

@@ -18,8 +18,8 @@ struct ScanPoint {
 };
 
 // The measured point, time and vertex of cloud point `index` (`raw`), as scanPointPixel() places it;
-// false when it has no usable time. The projection's winners take their vertex again by this, without
-// the pixel's arithmetic.
+// false when it has no usable time. The CUDA projection's winners take their vertex again by this,
+// without the pixel's arithmetic (the CPU projection keeps every placed point instead).
 ELO_HOST_DEVICE inline bool scanPointVertex(const ElevationCorrection& correction, const SweepDeskew& deskew, int index,
                                             const Float3& raw, ScanPoint& point) {
   point.measured = correction.apply(raw);

@@ -9,22 +9,28 @@
 
 namespace elo::cpu {
 
-void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
-                    BevImage& ground) {
+std::vector<int32_t> groundPixels(const ScanImage& scan) {
+  std::vector<int32_t> pixels;
+  parallelSelect(scan.label.size(), [&](size_t pixel) { return scan.label[pixel] == PixelLabel::ground; }, pixels);
+  return pixels;
+}
+
+// Each ground pixel's cell is found once, as it is offered; a pixel outside the map offers to cell -1,
+// which fillGroundMap() passes over, so the offers to cells come in the pixels' order.
+void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pixels, const BevProjection& projection,
+                    float same_surface_distance, std::vector<GroundOffer>& offers, BevImage& ground) {
   const SphericalImage& image = scan.image;
-  const auto cellOfPixel = [&](size_t pixel) {
+  offers.resize(ground_pixels.size());
+  parallelFor(ground_pixels.size(), [&](size_t i) {
+    const int32_t pixel = ground_pixels[i];
+    GroundOffer& offer = offers[i];
+    offer.vertex = image.vertex[pixel];
     int row = 0;
     int col = 0;
-    return projection.cellOf(image.vertex[pixel], row, col) ? row * projection.cols + col : -1;
-  };
-  std::vector<int32_t> pixels;
-  parallelSelect(
-      image.pixelCount(),
-      [&](size_t pixel) { return scan.label[pixel] == PixelLabel::ground && cellOfPixel(pixel) >= 0; }, pixels);
-  std::vector<GroundOffer> offers(pixels.size());
-  parallelFor(pixels.size(), [&](size_t i) {
-    const int32_t pixel = pixels[i];
-    offers[i] = {cellOfPixel(pixel), image.vertex[pixel], image.stamp[pixel], static_cast<uint32_t>(pixel)};
+    offer.cell = projection.cellOf(offer.vertex, row, col) ? row * projection.cols + col : -1;
+    offer.range = image.range[pixel];  // the norm of the vertex, as GroundOffer's constructor computes it
+    offer.stamp = image.stamp[pixel];
+    offer.source = static_cast<uint32_t>(pixel);
   });
   fillGroundMap(offers, same_surface_distance, ground);
 }
@@ -35,6 +41,7 @@ void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_di
   std::vector<int32_t> slot_of_offer(offers.size());
   for (size_t i = 0; i < offers.size(); ++i) {
     const GroundOffer& offer = offers[i];
+    if (offer.cell < 0) continue;
     int32_t& slot = map.point_of_cell[offer.cell];
     if (slot < 0) {
       slot = static_cast<int32_t>(map.cell.size());
@@ -50,6 +57,7 @@ void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_di
   std::vector<const GroundOffer*> winners(map.cell.size(), nullptr);
   for (size_t i = 0; i < offers.size(); ++i) {
     const GroundOffer& offer = offers[i];
+    if (offer.cell < 0) continue;
     const int32_t slot = slot_of_offer[i];
     if (!onClosestSurface(offer.range, map.range[slot], same_surface_distance)) continue;
     const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);

@@ -36,7 +36,7 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
   scan_velocity_ = deskew.velocity;
   size_t occupied = 0;
   arena_.execute([&] {
-    occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, scan_);
+    occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, placed_, scan_);
   });
   return occupied;
 }
@@ -55,6 +55,7 @@ void CpuBackend::segmentGround() {
     } else {
       cpu::segmentGround(config_.ground, scan_);
     }
+    ground_pixels_ = groundPixels(scan_);
   });
 }
 
@@ -66,8 +67,10 @@ void CpuBackend::estimateNormals() {
 }
 
 void CpuBackend::buildGroundMap() {
-  arena_.execute(
-      [&] { cpu::buildGroundMap(scan_, bev_, static_cast<float>(config_.model.same_surface_distance), scan_ground_); });
+  arena_.execute([&] {
+    cpu::buildGroundMap(scan_, ground_pixels_, bev_, static_cast<float>(config_.model.same_surface_distance),
+                        ground_offers_, scan_ground_);
+  });
 }
 
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {

@@ -37,10 +37,13 @@ class CpuBackend final : public Backend {
   TimeSource scan_times_ = TimeSource::none;
   SweepVelocity scan_velocity_{};
   std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
+  std::vector<int32_t> ground_pixels_;  // as labelled; the ground map is built (and rebuilt) from them
+  std::vector<GroundOffer> ground_offers_;  // the ground map's scratch
   BevImage scan_ground_;
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_
   ClosestWins winners_;  // the projection's closest point per pixel
+  std::vector<ScanPoint> placed_;  // the projection's cloud points as placed (corrected, deskewed, timed)
   SphericalFusionScratch fusion_scratch_;
   NormalScratch normal_scratch_;
   GroundNormalCache ground_normals_;

@@ -9,7 +9,7 @@ namespace elo::cpu {
 
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
-                    ScanImage& scan) {
+                    std::vector<ScanPoint>& placed, ScanImage& scan) {
   const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
   const bool use_ring = !ring_rows.empty() && cloud.ring.size() == cloud.points.size();
   const auto place = [&](size_t i, ScanPoint& point) {
@@ -17,13 +17,15 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
     return scanPointPixel(projection, correction, deskew, static_cast<int>(i), toFloat3(cloud.points[i]), ring,
                           ring_rows.data(), static_cast<int>(ring_rows.size()), point);
   };
+  // Every placed point is kept, so that the winners need not be corrected and deskewed again.
+  placed.resize(cloud.points.size());
   parallelFor(cloud.points.size(), [&](size_t i) {
-    ScanPoint point;
+    ScanPoint& point = placed[i];
     if (place(i, point)) winners.offer(point.pixel, norm(point.vertex), static_cast<uint32_t>(i));
   });
 
   // Each pixel takes its winner (which empties the pixel for the next scan). The winner's range is the
-  // one its key holds: the same norm of the same corrected point.
+  // one its key holds: the norm of the same vertex.
   SphericalImage& image = scan.image;
   return deterministicSum<size_t>(image.pixelCount(), [&](size_t begin, size_t end, size_t& occupied) {
     for (size_t pixel = begin; pixel < end; ++pixel) {
@@ -36,8 +38,7 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
         continue;
       }
       const uint32_t index = closestWinsSource(key);
-      ScanPoint point;
-      scanPointVertex(correction, deskew, static_cast<int>(index), toFloat3(cloud.points[index]), point);
+      const ScanPoint& point = placed[index];
       image.vertex[pixel] = toVec3f(point.vertex);
       image.range[pixel] = closestWinsRange(key);
       image.stamp[pixel] = stamp;

@@ -10,6 +10,7 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
+#include "core/common/scan_projection.hpp"
 #include "core/cpu/closest_wins.hpp"
 #include "elo/backend.hpp"
 #include "elo/sensor_model.hpp"
@@ -18,10 +19,11 @@ namespace elo::cpu {
 
 // projection.cpp: the closest point of the cloud per pixel, every point deskewed by `deskew` first;
 // `ring_rows` maps a driver's ring index to its row (empty: rows from the elevation). `winners` must be
-// empty, as resize() leaves it, and is left empty. Returns the number of occupied pixels.
+// empty, as resize() leaves it, and is left empty. `placed` is scratch: each cloud point as placed.
+// Returns the number of occupied pixels.
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
-                    ScanImage& scan);
+                    std::vector<ScanPoint>& placed, ScanImage& scan);
 
 // deskew.cpp: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
 void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
@@ -54,10 +56,6 @@ struct NormalScratch {
 void estimateNormals(const NormalConfig& config, const SphericalProjection& projection, NormalScratch& scratch,
                      ScanImage& scan);
 
-// bev_map.cpp: the BEV map of the ground pixels: per cell, the first pixel on the closest surface
-// (fillGroundMap below).
-void buildGroundMap(const ScanImage& scan, const BevProjection& projection, float same_surface_distance,
-                    BevImage& ground);
 // A point offered to a cell of a ground map by source `source` (the numbering the CUDA backend uses);
 // cell -1 offers nothing.
 struct GroundOffer {
@@ -71,8 +69,15 @@ struct GroundOffer {
   GroundOffer(int32_t to_cell, const Vec3f& point, float observed_at, uint32_t from_source)
       : cell(to_cell), vertex(point), range(norm(toFloat3(point))), stamp(observed_at), source(from_source) {}
 };
+
+// bev_map.cpp: the pixels labelled ground, in increasing order.
+std::vector<int32_t> groundPixels(const ScanImage& scan);
+// The BEV map of the ground pixels `ground_pixels` (groundPixels()): per cell, the first pixel on the
+// closest surface (fillGroundMap below). `offers` is scratch.
+void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pixels, const BevProjection& projection,
+                    float same_surface_distance, std::vector<GroundOffer>& offers, BevImage& ground);
 // Fills `map` with `offers` by the two rounds of model_update.hpp: each cell keeps the oldest offer on its
-// closest surface. Slots follow the first offer to each cell.
+// closest surface. Slots follow the first offer to each cell. Offers to cell -1 are passed over.
 void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map);
 
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
