@@ -1,22 +1,12 @@
 #include "elo/odometry.hpp"
 
-#include <chrono>
 #include <cmath>
 
+#include "core/elapsed_time.hpp"
 #include "elo/deskew.hpp"
 #include "elo/se3.hpp"
 
 namespace elo {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
 
 Odometry::Odometry(const Config& config) : config_(config), motion_(config.model.motion_prior) {
   validate(config_);

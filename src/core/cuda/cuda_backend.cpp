@@ -1,10 +1,10 @@
 #include "core/cuda/cuda_backend.hpp"
 
-#include <chrono>
 #include <cstring>
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/term_sums.hpp"
+#include "core/elapsed_time.hpp"
 #include "elo/sensor_model.hpp"
 
 namespace elo::cuda {
@@ -14,12 +14,6 @@ namespace {
 // Host and device arrays of points copy byte for byte.
 static_assert(sizeof(Vec3f) == sizeof(Float3), "Eigen::Vector3f and Float3 must both be three packed floats");
 static_assert(sizeof(PixelLabel) == 1, "labels copy byte for byte");
-
-using Clock = std::chrono::steady_clock;
-
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 template <typename T>
 void clear(const DeviceArray<T>& array, size_t count, int byte, cudaStream_t stream) {
