@@ -1,5 +1,5 @@
-// SphericalProjection::pixelOf() for 8 points at once, with AVX: the projection's and the model update's
-// loops over points and pixels. Per point, pixelOf() is a chain of divisions and square roots with
+// SphericalProjection::pixelOf() for 8 points at once, with AVX, for the projection's loop over the
+// cloud. Per point, pixelOf() is a chain of divisions and square roots with
 // branches on the point's octant that the branch predictor cannot learn; 8 lanes share one chain and the
 // branches become selects. Each lane performs pixelOf()'s float operations in its order, so it gives the
 // same pixel bit for bit (test_projection_ground_normals.cpp checks it against pixelOf() itself).
