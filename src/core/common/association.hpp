@@ -3,10 +3,7 @@
 //
 // A SphericalModel provides `rows`, `cols`, `bool matchable(int pixel)` (occupied, with a normal),
 // `Float3 vertex(int pixel)` and `Float3 normal(int pixel)`. A GroundMap provides `int32_t
-// pointOfCell(int cell)` (-1: empty), `Float3 vertex(int32_t point)`, `int32_t cell(int32_t point)` and
-// `forEachPointInCells(int first_cell, int last_cell, Visit& visit)`: `visit(point)` for the point of
-// each occupied cell from `first_cell` to `last_cell` of one grid row, in that order (a map may find
-// them faster than one cell at a time, as the CPU backend's does from an occupancy bitmap).
+// pointOfCell(int cell)` (-1: empty), `Float3 vertex(int32_t point)` and `int32_t cell(int32_t point)`.
 #pragma once
 
 #include <cmath>
@@ -92,6 +89,16 @@ ELO_HOST_DEVICE bool nongroundMatch(const SphericalProjection& projection, const
   return !(dot(motion.rotate(normal), model.normal(match)) < gates.min_normal_cosine);
 }
 
+namespace detail {
+
+template <typename GroundMap, typename Visit>
+ELO_HOST_DEVICE void visitCell(const GroundMap& map, int cell, Visit& visit) {
+  const int32_t point = map.pointOfCell(cell);
+  if (point >= 0) visit(point);
+}
+
+}  // namespace detail
+
 // Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`,
 // row by row and, within a row, column by column.
 template <typename GroundMap, typename Visit>
@@ -106,10 +113,10 @@ ELO_HOST_DEVICE void forEachPointOnRing(const GroundMap& map, const BevProjectio
   for (int r = first_row; r <= last_row; ++r) {
     const int row_start = r * projection.cols;
     if (r == row - ring || r == row + ring) {  // the ring's top and bottom rows: every cell
-      map.forEachPointInCells(row_start + first_col, row_start + last_col, visit);
+      for (int c = first_col; c <= last_col; ++c) detail::visitCell(map, row_start + c, visit);
     } else {  // rows in between: only the ring's two ends
-      if (left >= 0) map.forEachPointInCells(row_start + left, row_start + left, visit);
-      if (right < projection.cols) map.forEachPointInCells(row_start + right, row_start + right, visit);
+      if (left >= 0) detail::visitCell(map, row_start + left, visit);
+      if (right < projection.cols) detail::visitCell(map, row_start + right, visit);
     }
   }
 }

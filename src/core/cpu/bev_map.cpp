@@ -75,26 +75,6 @@ void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_di
   }
 }
 
-void CellOrderedGround::build(const BevImage& map) {
-  const size_t words = (map.cellCount() + kCellsPerWord - 1) / kCellsPerWord;
-  occupied_.assign(words, 0);
-  for (int32_t cell : map.cell) occupied_[cell / kCellsPerWord] |= uint64_t{1} << (cell % kCellsPerWord);
-  points_before_.resize(words);
-  int32_t points = 0;
-  for (size_t word = 0; word < words; ++word) {
-    points_before_[word] = points;
-    points += __builtin_popcountll(occupied_[word]);
-  }
-  vertex_.resize(map.size());
-  cell_.resize(map.size());
-  parallelFor(map.size(), [&](size_t point) {
-    const int32_t cell = map.cell[point];
-    const int32_t rank = pointOfCell(cell);
-    vertex_[rank] = toFloat3(map.vertex[point]);
-    cell_[rank] = cell;
-  });
-}
-
 void GroundNormalCache::reset(size_t points) {
   if (points > capacity_) {
     capacity_ = points + points / 2;
@@ -104,10 +84,11 @@ void GroundNormalCache::reset(size_t points) {
   for (size_t i = 0; i < points; ++i) states_[i].store(unknown, std::memory_order_relaxed);
 }
 
-Float3 GroundNormalCache::normal(const CellOrderedGround& model, const BevProjection& projection,
-                                 const BevConfig& config, int32_t point) {
+Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& projection, const BevConfig& config,
+                                int32_t point) {
   if (states_[point].load(std::memory_order_acquire) == fitted) return normals_[point];
-  const Float3 normal = groundNormal(model, projection, point, config.normal_neighbours, config.normal_patch_radius);
+  const Vec3f normal =
+      toVec3f(groundNormal(GroundPoints(model), projection, point, config.normal_neighbours, config.normal_patch_radius));
   uint8_t expected = unknown;
   if (states_[point].compare_exchange_strong(expected, fitting, std::memory_order_acq_rel)) {
     normals_[point] = normal;

@@ -71,24 +71,25 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
   }).unpacked();
 }
 
-TermSums groundSums(const BevImage& scan_ground, const CellOrderedGround& model, const BevProjection& projection,
+TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const BevProjection& projection,
                     GroundNormalCache& normals, const Eigen::Isometry3d& model_from_scan, double kernel_scale,
                     const RegistrationConfig& registration, const BevConfig& bev) {
   const Rigid3f motion = toRigid3f(model_from_scan);
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(registration);
+  const GroundPoints model_points(model);
   return deterministicSum<PackedSums>(scan_ground.size(), [&](size_t begin, size_t end, PackedSums& block_sums) {
     PackedSums sums;
     for (size_t i = begin; i < end; ++i) {
       ++sums.candidates;
       Float3 moved;
       int32_t match = -1;
-      if (!groundMatch(projection, model, motion, toFloat3(scan_ground.vertex[i]), gates, bev.normal_patch_radius,
+      if (!groundMatch(projection, model_points, motion, toFloat3(scan_ground.vertex[i]), gates, bev.normal_patch_radius,
                        moved, match)) {
         continue;
       }
-      const Float3 normal = normals.normal(model, projection, bev, match);
+      const Float3 normal = toFloat3(normals.normal(model, projection, bev, match));
       if (isZero(normal)) continue;
-      sums.add(pointToPlane(moved, model.vertex(match), normal, kernel_scale));
+      sums.add(pointToPlane(moved, model_points.vertex(match), normal, kernel_scale));
     }
     block_sums = sums;
   }).unpacked();

@@ -28,7 +28,6 @@ CpuBackend::CpuBackend(const Config& config)
   allocate(fused_, spherical_, bev_);
   winners_.resize(scan_.image.pixelCount());
   fusion_scratch_.resize(scan_.image.pixelCount());
-  groundModelChanged();
 }
 
 size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion) {
@@ -83,7 +82,7 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
                                      kernel_scale, config_.registration);
     }
     if (terms == CostTerms::fused || terms == CostTerms::bev_ground) {
-      sums.ground = groundSums(scan_ground_, model_ground_, bev_, ground_normals_, model_from_scan, kernel_scale,
+      sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,
                                config_.registration, config_.bev);
     }
   });
@@ -93,7 +92,7 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
 void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) {
   if (!model_.initialized || config_.model.mode == RegistrationMode::frame_to_frame) {
     arena_.execute([&] { copyScanToModel(scan_, scan_ground_, model_); });
-    groundModelChanged();
+    ground_normals_.reset(model_.ground.size());
     return;
   }
   const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
@@ -103,19 +102,13 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   });
   std::swap(model_, fused_);
   model_.initialized = true;
-  groundModelChanged();
-}
-
-void CpuBackend::groundModelChanged() {
-  arena_.execute([&] { model_ground_.build(model_.ground); });
-  ground_normals_.reset(model_ground_.size());
+  ground_normals_.reset(model_.ground.size());
 }
 
 void CpuBackend::resetModel() {
   model_.nonground.clear();
   model_.ground.clear();
   model_.initialized = false;
-  groundModelChanged();
 }
 
 }  // namespace elo::cpu

@@ -26,9 +26,6 @@ class CpuBackend final : public Backend {
   const Model& model() override { return model_; }
 
  private:
-  // Sorts the new ground model for the searches and forgets its normals.
-  void groundModelChanged();
-
   Config config_;
   SphericalProjection spherical_;
   BevProjection bev_;
@@ -49,8 +46,7 @@ class CpuBackend final : public Backend {
   std::vector<ScanPoint> placed_;  // the projection's cloud points as placed (corrected, deskewed, timed)
   SphericalFusionScratch fusion_scratch_;
   NormalScratch normal_scratch_;
-  CellOrderedGround model_ground_;  // model_.ground sorted for the registration's searches
-  GroundNormalCache ground_normals_;  // of model_ground_'s points
+  GroundNormalCache ground_normals_;
 };
 
 }  // namespace elo::cpu

@@ -1,6 +1,5 @@
 // The CPU backend's images in the shapes the shared per-element math (src/core/common) takes: the
-// Image and SphericalModel of normals.hpp, ground.hpp and association.hpp (its GroundMap is
-// CellOrderedGround, stages.hpp).
+// Image, SphericalModel and GroundMap of normals.hpp, ground.hpp and association.hpp.
 #pragma once
 
 #include "core/common/eigen_interop.hpp"
@@ -42,6 +41,17 @@ struct ModelPixels {
   bool matchable(int pixel) const { return image.occupied(pixel) && image.hasNormal(pixel); }
   Float3 vertex(int pixel) const { return toFloat3(image.vertex[pixel]); }
   Float3 normal(int pixel) const { return toFloat3(image.normal[pixel]); }
+};
+
+// The points of a BEV map.
+struct GroundPoints {
+  explicit GroundPoints(const BevImage& map) : map(map) {}
+
+  const BevImage& map;
+
+  int32_t pointOfCell(int cell) const { return map.point_of_cell[cell]; }
+  Float3 vertex(int32_t point) const { return toFloat3(map.vertex[point]); }
+  int32_t cell(int32_t point) const { return map.cell[point]; }
 };
 
 }  // namespace elo::cpu

@@ -80,51 +80,6 @@ void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pi
 // closest surface. Slots follow the first offer to each cell. Offers to cell -1 are passed over.
 void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map);
 
-// A BEV map's points sorted by cell (row-major), for the registration's searches: the GroundMap of
-// association.hpp, where a point is its rank in cell order. Which cells hold a point is one bit a cell,
-// and a cell's rank the points before its 64-cell word plus those before it in the word, so a search
-// reads a 0.5 MB bitmap and points that lie next to each other in memory instead of the 11.5 MB grid of
-// point indices and points in the map's order (cache misses on both). The cells visited, their order
-// and the vertices are the map's, so every search finds what it finds on the map itself, bit for bit.
-class CellOrderedGround {
- public:
-  // Sorts the points of `map`; call whenever the map changes.
-  void build(const BevImage& map);
-
-  int32_t pointOfCell(int cell) const {
-    const size_t word = static_cast<size_t>(cell) / kCellsPerWord;
-    const uint64_t bit = uint64_t{1} << (static_cast<unsigned>(cell) % kCellsPerWord);
-    const uint64_t occupied = occupied_[word];
-    if (!(occupied & bit)) return -1;
-    return points_before_[word] + __builtin_popcountll(occupied & (bit - 1));
-  }
-  Float3 vertex(int32_t point) const { return vertex_[point]; }
-  int32_t cell(int32_t point) const { return cell_[point]; }
-  // The occupied cells of a row's span are the set bits of one or two words, and their points follow
-  // each other from the rank of the first.
-  template <typename Visit>
-  void forEachPointInCells(int first_cell, int last_cell, Visit& visit) const {
-    const size_t last_word = static_cast<size_t>(last_cell) / kCellsPerWord;
-    unsigned first_bit = static_cast<unsigned>(first_cell) % kCellsPerWord;
-    for (size_t word = static_cast<size_t>(first_cell) / kCellsPerWord; word <= last_word; ++word, first_bit = 0) {
-      const unsigned last_bit = word == last_word ? static_cast<unsigned>(last_cell) % kCellsPerWord : kCellsPerWord - 1;
-      const uint64_t occupied = occupied_[word];
-      uint64_t in_span = occupied & (~uint64_t{0} >> (kCellsPerWord - 1 - last_bit)) & (~uint64_t{0} << first_bit);
-      if (!in_span) continue;
-      int32_t point = points_before_[word] + __builtin_popcountll(occupied & ((uint64_t{1} << first_bit) - 1));
-      for (; in_span; in_span &= in_span - 1) visit(point++);
-    }
-  }
-  size_t size() const { return vertex_.size(); }
-
- private:
-  static constexpr int kCellsPerWord = 64;
-  std::vector<uint64_t> occupied_;      // bit c % 64 of word c / 64: whether cell c holds a point
-  std::vector<int32_t> points_before_;  // per word: the points in all cells before it
-  std::vector<Float3> vertex_;          // per point, in cell order
-  std::vector<int32_t> cell_;
-};
-
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
 // (Sec. III-C.2, groundNormal() of association.hpp) and kept until the model changes. Safe to query from
 // many threads: a cell is fitted from the model alone, so whichever thread fits it first stores the same
@@ -134,13 +89,12 @@ class GroundNormalCache {
   // Forgets every normal; call whenever the model changes, with its new point count.
   void reset(size_t points);
   // The normal of model point `point` (zero when its neighbours give no plane).
-  Float3 normal(const CellOrderedGround& model, const BevProjection& projection, const BevConfig& config,
-                int32_t point);
+  Vec3f normal(const BevImage& model, const BevProjection& projection, const BevConfig& config, int32_t point);
 
  private:
   enum State : uint8_t { unknown = 0, fitting = 1, fitted = 2 };
   size_t capacity_ = 0;
-  std::vector<Float3> normals_;
+  std::vector<Vec3f> normals_;
   std::unique_ptr<std::atomic<uint8_t>[]> states_;
 };
 
@@ -150,7 +104,7 @@ std::vector<int32_t> registrationPixels(const ScanImage& scan);
 TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels, const SphericalImage& model,
                        const SphericalProjection& projection, const Eigen::Isometry3d& model_from_scan,
                        double kernel_scale, const RegistrationConfig& config);
-TermSums groundSums(const BevImage& scan_ground, const CellOrderedGround& model, const BevProjection& projection,
+TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const BevProjection& projection,
                     GroundNormalCache& normals, const Eigen::Isometry3d& model_from_scan, double kernel_scale,
                     const RegistrationConfig& registration, const BevConfig& bev);
 

@@ -60,13 +60,6 @@ struct DeviceBev {
   ELO_HOST_DEVICE int32_t pointOfCell(int cell) const { return point_of_cell[cell]; }
   ELO_HOST_DEVICE Float3 vertex(int32_t point) const { return vertices[point]; }
   ELO_HOST_DEVICE int32_t cell(int32_t point) const { return cells[point]; }
-  template <typename Visit>
-  ELO_HOST_DEVICE void forEachPointInCells(int first_cell, int last_cell, Visit& visit) const {
-    for (int cell = first_cell; cell <= last_cell; ++cell) {
-      const int32_t point = point_of_cell[cell];
-      if (point >= 0) visit(point);
-    }
-  }
 };
 
 }  // namespace elo::cuda
