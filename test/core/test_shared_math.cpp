@@ -145,7 +145,9 @@ TEST(RingOfCells, VisitsEachOccupiedCellAtThatDistanceOnceInRowMajorOrder) {
   std::mt19937 random(5);
   std::bernoulli_distribution occupied(0.7);
   NumberedCells map;
-  for (int cell = 0; cell < bev.rows * bev.cols; ++cell) map.point_of_cell.push_back(occupied(random) ? cell : -1);
+  for (int cell = 0; cell < bev.rows * bev.cols; ++cell) {
+    map.point_of_cell.push_back(occupied(random) ? cell : -1);
+  }
   for (int row = 0; row < bev.rows; ++row) {
     for (int col = 0; col < bev.cols; ++col) {
       for (int ring = 0; ring <= 14; ++ring) {
