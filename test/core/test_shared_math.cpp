@@ -9,6 +9,7 @@
 #include <random>
 
 #include "analytic_scene.hpp"
+#include "core/common/association.hpp"
 #include "core/common/closest_wins_key.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/common/ground.hpp"
@@ -125,6 +126,43 @@ TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsARing) {
   std::vector<Float3> ring;
   for (int i = 0; i < 5; ++i) ring.push_back({10.0f + 0.1f * i, 2.0f, -1.73f});  // one line in x-y
   EXPECT_TRUE(isZero(groundPlaneNormal(ring.data(), 5, ring[0])));
+}
+
+// A GroundMap of a small grid in which chosen cells hold a point numbered like the cell.
+struct NumberedCells {
+  std::vector<int32_t> point_of_cell;
+  int32_t pointOfCell(int cell) const { return point_of_cell[cell]; }
+};
+
+// The ring search and the ground normals' fits visit a ring's cells row by row and, within a row, column
+// by column (the order decides ties between equally distant points): every cell at that Chebyshev
+// distance inside the grid, once, and no other, wherever the ring is clipped by the grid's edges.
+TEST(RingOfCells, VisitsEachOccupiedCellAtThatDistanceOnceInRowMajorOrder) {
+  BevConfig config;
+  config.half_length = 0.65;  // 13 x 9 cells
+  config.half_width = 0.45;
+  const BevProjection bev = BevProjection::fromConfig(config);
+  std::mt19937 random(5);
+  std::bernoulli_distribution occupied(0.7);
+  NumberedCells map;
+  for (int cell = 0; cell < bev.rows * bev.cols; ++cell) {
+    map.point_of_cell.push_back(occupied(random) ? cell : -1);
+  }
+  for (int row = 0; row < bev.rows; ++row) {
+    for (int col = 0; col < bev.cols; ++col) {
+      for (int ring = 0; ring <= 14; ++ring) {
+        std::vector<int32_t> expected;  // row-major order is increasing cell number
+        for (int cell = 0; cell < bev.rows * bev.cols; ++cell) {
+          const int distance = std::max(std::abs(cell / bev.cols - row), std::abs(cell % bev.cols - col));
+          if (distance == ring && map.point_of_cell[cell] >= 0) expected.push_back(cell);
+        }
+        std::vector<int32_t> visited;
+        auto visit = [&](int32_t point) { visited.push_back(point); };
+        forEachPointOnRing(map, bev, row, col, ring, visit);
+        ASSERT_EQ(visited, expected) << "row " << row << ", col " << col << ", ring " << ring;
+      }
+    }
+  }
 }
 
 TEST(ClosestWinsKey, CloserWinsTiesGoToTheLowerSourceAndNoneLosesToAll) {

@@ -97,27 +97,41 @@ ELO_HOST_DEVICE void visitCell(const GroundMap& map, int cell, Visit& visit) {
   if (point >= 0) visit(point);
 }
 
+template <typename GroundMap, typename Visit>
+ELO_HOST_DEVICE void visitCells(const GroundMap& map, int first_cell, int last_cell, Visit& visit) {
+  for (int cell = first_cell; cell <= last_cell; ++cell) visitCell(map, cell, visit);
+}
+
 }  // namespace detail
 
 // Visits every point of `map` in the cells at Chebyshev distance `ring` from (row, col): `visit(point)`,
-// row by row and, within a row, column by column.
+// row by row and, within a row, column by column. The top row, the two ends of the rows in between and
+// the bottom row are separate loops (no test of which kind each row is).
 template <typename GroundMap, typename Visit>
 ELO_HOST_DEVICE void forEachPointOnRing(const GroundMap& map, const BevProjection& projection, int row, int col,
                                         int ring, Visit& visit) {
-  const int first_row = row - ring < 0 ? 0 : row - ring;
-  const int last_row = row + ring > projection.rows - 1 ? projection.rows - 1 : row + ring;
+  if (ring == 0) {
+    detail::visitCell(map, row * projection.cols + col, visit);
+    return;
+  }
+  const int top = row - ring;
+  const int bottom = row + ring;
   const int left = col - ring;  // the ring's two columns; either may lie outside the grid
   const int right = col + ring;
   const int first_col = left < 0 ? 0 : left;
   const int last_col = right > projection.cols - 1 ? projection.cols - 1 : right;
-  for (int r = first_row; r <= last_row; ++r) {
+  if (top >= 0) detail::visitCells(map, top * projection.cols + first_col, top * projection.cols + last_col, visit);
+  const int first_middle = top + 1 < 0 ? 0 : top + 1;
+  const int last_middle = bottom - 1 > projection.rows - 1 ? projection.rows - 1 : bottom - 1;
+  const bool left_inside = left >= 0;
+  const bool right_inside = right < projection.cols;
+  for (int r = first_middle; r <= last_middle; ++r) {
     const int row_start = r * projection.cols;
-    if (r == row - ring || r == row + ring) {  // the ring's top and bottom rows: every cell
-      for (int c = first_col; c <= last_col; ++c) detail::visitCell(map, row_start + c, visit);
-    } else {  // rows in between: only the ring's two ends
-      if (left >= 0) detail::visitCell(map, row_start + left, visit);
-      if (right < projection.cols) detail::visitCell(map, row_start + right, visit);
-    }
+    if (left_inside) detail::visitCell(map, row_start + left, visit);
+    if (right_inside) detail::visitCell(map, row_start + right, visit);
+  }
+  if (bottom < projection.rows) {
+    detail::visitCells(map, bottom * projection.cols + first_col, bottom * projection.cols + last_col, visit);
   }
 }
 

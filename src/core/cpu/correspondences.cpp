@@ -77,20 +77,31 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
   const Rigid3f motion = toRigid3f(model_from_scan);
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(registration);
   const GroundPoints model_points(model);
+  // Each correspondence's model normal is read (or fitted) one correspondence after its association,
+  // with a prefetch in between: the cache's normals are indexed in the model's order, so most reads miss,
+  // and the next association hides the wait. The sums are added in the same order as without it.
   return deterministicSum<PackedSums>(scan_ground.size(), [&](size_t begin, size_t end, PackedSums& block_sums) {
     PackedSums sums;
+    Float3 pending_moved{};
+    int32_t pending_match = -1;  // the previous correspondence's model point; -1: none to add
+    const auto add_pending = [&] {
+      const Float3 normal = toFloat3(normals.normal(model, projection, bev, pending_match));
+      if (isZero(normal)) return;
+      sums.add(pointToPlane(pending_moved, model_points.vertex(pending_match), normal, kernel_scale));
+    };
     for (size_t i = begin; i < end; ++i) {
       ++sums.candidates;
       Float3 moved;
       int32_t match = -1;
-      if (!groundMatch(projection, model_points, motion, toFloat3(scan_ground.vertex[i]), gates, bev.normal_patch_radius,
-                       moved, match)) {
-        continue;
-      }
-      const Float3 normal = toFloat3(normals.normal(model, projection, bev, match));
-      if (isZero(normal)) continue;
-      sums.add(pointToPlane(moved, model_points.vertex(match), normal, kernel_scale));
+      const bool matched = groundMatch(projection, model_points, motion, toFloat3(scan_ground.vertex[i]), gates,
+                                       bev.normal_patch_radius, moved, match);
+      if (!matched) continue;
+      normals.prefetch(match);
+      if (pending_match >= 0) add_pending();
+      pending_moved = moved;
+      pending_match = match;
     }
+    if (pending_match >= 0) add_pending();
     block_sums = sums;
   }).unpacked();
 }

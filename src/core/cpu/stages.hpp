@@ -97,6 +97,11 @@ class GroundNormalCache {
  public:
   // Forgets every normal; call whenever the model changes, with its new point count.
   void reset(size_t points);
+  // Starts loading what normal() will read for `point`.
+  void prefetch(int32_t point) const {
+    __builtin_prefetch(&states_[point]);
+    __builtin_prefetch(&normals_[point]);
+  }
   // The normal of model point `point` (zero when its neighbours give no plane).
   Vec3f normal(const BevImage& model, const BevProjection& projection, const BevConfig& config, int32_t point);
 
