@@ -1,11 +1,11 @@
 // Whether a cloud fits the configured sensor model (sensor.*): the share of its points the spherical
 // projection cannot place because they lie above or below the range image's field of view or carry a
 // ring index past the configured beams, and of those it places in the wrong row because their ring's
-// beam (sensor.beam_elevations_deg, indexed by the driver's ring) is not where they are. Run with another
-// LiDAR's settings (the HDL-64E defaults on a VLP-16's scans, say), a third of each scan falls off the
-// image and the odometry drifts by metres with no other sign; with a table in the other ring order
-// (velodyne_pointcloud numbers rings from the lowest beam up, ouster_ros from the highest down) every
-// row is upside down. This check names the cause.
+// beam (ringElevations()) is not where they are. Run with another LiDAR's settings (the HDL-64E
+// defaults on a VLP-16's scans, say), a third of each scan falls off the image and the odometry drifts
+// by metres with no other sign; with the other ring numbering (sensor.ring_zero: velodyne_pointcloud
+// counts rings up from the lowest beam, ouster_ros down from the highest) every row is upside down.
+// This check names the cause.
 #pragma once
 
 #include <cstddef>
@@ -33,7 +33,7 @@ struct SensorFit {
 constexpr double kMaxMisplacedShare = 0.05;
 // A point's elevation seen from the sensor's origin differs from its beam's by the beam's calibration
 // (tenths of a degree) and, close in, by where on the head the laser sits (0.2 m apart on an HDL-64E:
-// under 0.8 deg beyond 15 m); beams are 0.3 to 2 deg apart, so a table in the wrong order misses by more.
+// under 0.8 deg beyond 15 m); beams are 0.3 to 2 deg apart, so the other ring numbering misses by more.
 constexpr double kRingCheckRange = 15.0;  // m
 constexpr double kMaxBeamOffsetDeg = 1.5;
 

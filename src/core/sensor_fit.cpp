@@ -21,7 +21,7 @@ SensorFit checkSensorFit(const PointCloud& cloud, const SensorConfig& sensor, si
   const double max_squared = sensor.max_range * sensor.max_range;
   const double fov_up = sensor.fov_up_deg * M_PI / 180.0;
   const double fov_down = sensor.fov_down_deg * M_PI / 180.0;
-  const std::vector<float> beams = beamElevations(sensor);
+  const std::vector<float> beams = ringElevations(sensor);
   const double ring_check_squared = kRingCheckRange * kRingCheckRange;
   const double max_beam_offset = kMaxBeamOffsetDeg * M_PI / 180.0;
   const bool has_rings = cloud.ring.size() == cloud.points.size();
@@ -54,8 +54,9 @@ std::string SensorFit::warning(const SensorConfig& sensor) const {
                 "%.0f%% of the scan's points do not fit the sensor model '%s' (%.0f%% above its field of view's "
                 "top at %+.1f deg, %.0f%% below its bottom at %+.1f deg, %.0f%% with a ring past its %zu beams: "
                 "left out; %.0f%% over %.1f deg from their ring's beam: put in the wrong row): are the sensor.* "
-                "settings this LiDAR's (config/*.yaml, --config), with sensor.beam_elevations_deg in the "
-                "driver's ring order (velodyne_pointcloud counts rings up from the lowest beam)?",
+                "settings this LiDAR's (config/*.yaml, --config), with the "
+                "right sensor.ring_zero (velodyne_pointcloud counts rings up from the lowest beam, ouster_ros down "
+                "from the highest)?",
                 percent(misplaced(), sampled), sensor.name.c_str(), percent(above, sampled), sensor.fov_up_deg,
                 percent(below, sampled), sensor.fov_down_deg, percent(unknown_ring, sampled),
                 beamElevations(sensor).size(), percent(off_beam, sampled), kMaxBeamOffsetDeg);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "elo/sensor_fit.hpp"
+#include "elo/sensor_model.hpp"
 
 namespace elo {
 namespace {
@@ -14,6 +15,9 @@ Vec3f pointAtElevation(double elevation_deg) {
   const double elevation = elevation_deg * M_PI / 180.0;
   return Vec3f(static_cast<float>(20.0 * std::cos(elevation)), 0.0f, static_cast<float>(20.0 * std::sin(elevation)));
 }
+
+// The nominal elevation (deg) of the beam `sensor` numbers `ring`.
+double ringElevationDeg(const SensorConfig& sensor, int ring) { return ringElevations(sensor)[ring] * 180.0 / M_PI; }
 
 PointCloud cloudOf(const std::vector<std::pair<double, uint16_t>>& elevations_and_rings) {
   PointCloud cloud;
@@ -27,7 +31,7 @@ PointCloud cloudOf(const std::vector<std::pair<double, uint16_t>>& elevations_an
 // The HDL-64E defaults: image from +3 to -25 deg, 64 beams.
 TEST(SensorFit, CountsPointsAboveAndBelowTheImageAndRingsPastTheBeams) {
   const SensorConfig hdl64;
-  PointCloud cloud = cloudOf({{10.0, 0}, {-30.0, 63}, {-10.0, 70}, {hdl64.beam_elevations_deg[40], 40}, {2.0, 0}});
+  PointCloud cloud = cloudOf({{10.0, 0}, {-30.0, 63}, {-10.0, 70}, {ringElevationDeg(hdl64, 40), 40}, {2.0, 63}});  // ring 63: the top beam, +2 deg
   cloud.points.push_back(Vec3f(NAN, 0.0f, 0.0f));  // not finite: not sampled
   cloud.ring.push_back(2);
   cloud.points.push_back(Vec3f(1.0f, 0.0f, 0.0f));  // closer than sensor.min_range: not sampled
@@ -43,18 +47,23 @@ TEST(SensorFit, CountsPointsAboveAndBelowTheImageAndRingsPastTheBeams) {
   EXPECT_NE(warning.find("past its 64 beams"), std::string::npos) << warning;
 }
 
-// A table in the other ring order (velodyne_pointcloud's rings count up from the lowest beam): each
-// point's ring names a beam on the other side of the field of view.
+// Rings numbered the other way (ouster_ros's from the top, where the HDL-64E settings expect
+// velodyne_pointcloud's from the bottom): each point's ring names a beam on the other side of the field
+// of view.
 TEST(SensorFit, CountsPointsFarFromTheirRingsBeam) {
   const SensorConfig hdl64;
+  ASSERT_EQ(hdl64.ring_zero, RingZero::bottom);
   std::vector<std::pair<double, uint16_t>> points;
-  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({hdl64.beam_elevations_deg[63 - ring], ring});
+  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({hdl64.beam_elevations_deg[ring], ring});
   const SensorFit flipped = checkSensorFit(cloudOf(points), hdl64, 1);
   EXPECT_EQ(flipped.sampled, 64u);
   EXPECT_GE(flipped.off_beam, 56u);  // all but the few beams near the table's middle
   EXPECT_NE(flipped.warning(hdl64).find("over 1.5 deg from their ring's beam"), std::string::npos);
+  SensorConfig top_first = hdl64;
+  top_first.ring_zero = RingZero::top;
+  EXPECT_EQ(checkSensorFit(cloudOf(points), top_first, 1).off_beam, 0u);
   points.clear();
-  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({hdl64.beam_elevations_deg[ring] - 0.5, ring});
+  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({ringElevationDeg(hdl64, ring) - 0.5, ring});
   EXPECT_EQ(checkSensorFit(cloudOf(points), hdl64, 1).off_beam, 0u);  // half a degree off: calibration
 }
 
@@ -73,7 +82,7 @@ TEST(SensorFit, RingsAreLeftUncheckedWhenTheCloudHasNone) {
 
 // A few stray points (multipath, a reflection above the horizon) are no reason to warn; a sixth is.
 TEST(SensorFit, WarnsOnlyAboveTheMisplacedShare) {
-  std::vector<std::pair<double, uint16_t>> points(100, {SensorConfig().beam_elevations_deg[10], 10});
+  std::vector<std::pair<double, uint16_t>> points(100, {ringElevationDeg(SensorConfig(), 10), 10});
   for (int i = 0; i < 5; ++i) points[i] = {10.0, 10};
   const SensorConfig hdl64;
   EXPECT_EQ(checkSensorFit(cloudOf(points), hdl64, 1).warning(hdl64), "");
@@ -85,8 +94,8 @@ TEST(SensorFit, WarnsOnlyAboveTheMisplacedShare) {
 TEST(SensorFit, TestsElevationsAfterTheCorrection) {
   SensorConfig sensor;
   sensor.elevation_correction_deg = 1.0;
-  EXPECT_EQ(checkSensorFit(cloudOf({{2.5, 0}}), sensor, 1).above, 1u);
-  EXPECT_EQ(checkSensorFit(cloudOf({{1.5, 0}}), sensor, 1).above, 0u);
+  EXPECT_EQ(checkSensorFit(cloudOf({{2.5, 63}}), sensor, 1).above, 1u);
+  EXPECT_EQ(checkSensorFit(cloudOf({{1.5, 63}}), sensor, 1).above, 0u);
 }
 
 TEST(SensorFit, SamplesEveryStrideThPoint) {
