@@ -15,6 +15,7 @@ struct Fixture {
   SphericalProjection spherical = SphericalProjection::fromConfig(config.sensor);
   BevProjection bev = BevProjection::fromConfig(config.bev);
   cpu::SphericalFusionScratch scratch;
+  cpu::GroundMapScratch ground_scratch;
 
   // The spherical model, a scan and the fused result: empty, of the projection's size.
   SphericalImage model, fused;
@@ -170,7 +171,7 @@ TEST(ModelUpdate, GroundMapKeepsTheOldestPointOfTheRoadAndExpiresOldOnes) {
 
   const auto fuseAt12 = [&] {
     cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
-                         ModelFusion::fromConfig(f.config.model, 12.0f), fused);
+                         ModelFusion::fromConfig(f.config.model, 12.0f), f.ground_scratch, fused);
   };
   fuseAt12();
   ASSERT_EQ(fused.size(), 1u) << "the point observed 12 s ago must have expired";
@@ -193,12 +194,12 @@ TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
   const Vec3f farther(10.05f, 3.04f, -1.75f);
   const Vec3f nearer(10.01f, 3.01f, -1.72f);
   const int32_t cell = f.cellOf(farther);
-  const std::vector<cpu::GroundOffer> offers = {{cell, nearer, 1.0f, 9}, {cell, farther, 1.0f, 7}};
-  cpu::fillGroundMap(offers, 0.3f, map);
+  f.ground_scratch.offers = {{cell, nearer, 1.0f, 9}, {cell, farther, 1.0f, 7}};
+  cpu::fillGroundMap(0.3f, f.ground_scratch, map);
   ASSERT_EQ(map.size(), 1u);
   EXPECT_EQ(map.vertex[0], farther);
   EXPECT_FLOAT_EQ(map.range[0], farther.norm());
-  cpu::fillGroundMap(offers, 0.0f, map);
+  cpu::fillGroundMap(0.0f, f.ground_scratch, map);
   EXPECT_EQ(map.vertex[0], nearer);
 }
 
@@ -218,9 +219,9 @@ TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
   ASSERT_EQ(f.cellOf(b_near), b);
   ASSERT_GT(f.cellOf(c), a);  // the slots' order is not the cells'
   ASSERT_GT(a, b);
-  const std::vector<cpu::GroundOffer> offers = {
+  f.ground_scratch.offers = {
       {f.cellOf(c), c, 2.0f, 0}, {b, b_far, 1.0f, 1}, {a, a_new, 2.0f, 2}, {b, b_near, 2.0f, 3}, {a, a_old, 1.0f, 4}};
-  cpu::fillGroundMap(offers, 0.3f, map);
+  cpu::fillGroundMap(0.3f, f.ground_scratch, map);
   ASSERT_EQ(map.cell, (std::vector<int32_t>{f.cellOf(c), b, a}));
   for (int32_t slot = 0; slot < 3; ++slot) EXPECT_EQ(map.point_of_cell[map.cell[slot]], slot);
   EXPECT_EQ(map.vertex[0], c);
@@ -248,7 +249,7 @@ TEST(ModelUpdate, FusedGroundMapKeepsTheModelsOrderThenTheScans) {
   scan_ground.keepCloser(f.cellOf(w), w, 12.0f);
   scan_ground.keepCloser(f.cellOf(x), x + Vec3f(0.0f, 0.0f, 0.01f), 12.0f);
   cpu::fuseGroundModel(model, scan_ground, f.bev, Eigen::Isometry3d::Identity(),
-                       ModelFusion::fromConfig(f.config.model, 12.0f), fused);
+                       ModelFusion::fromConfig(f.config.model, 12.0f), f.ground_scratch, fused);
   ASSERT_GT(f.cellOf(y), f.cellOf(z));  // the slots' order is not the cells'
   EXPECT_EQ(fused.cell, (std::vector<int32_t>{f.cellOf(y), f.cellOf(x), f.cellOf(z), f.cellOf(w)}));
   EXPECT_EQ(fused.vertex, (std::vector<Vec3f>{y, x, z, w}));
@@ -268,7 +269,8 @@ TEST(ModelUpdate, GroundMapMovesWithTheSensorAndStaysBounded) {
       const Vec3f p(-10.0f + 0.4f * i, 0.0f, -1.73f);
       scan_ground.keepCloser(f.cellOf(p), p, 0.1f * frame);
     }
-    cpu::fuseGroundModel(model, scan_ground, f.bev, step, ModelFusion::fromConfig(f.config.model, 0.1f * frame), fused);
+    cpu::fuseGroundModel(model, scan_ground, f.bev, step, ModelFusion::fromConfig(f.config.model, 0.1f * frame),
+                         f.ground_scratch, fused);
     std::swap(model, fused);
   }
   // A point seen at x = 0 one frame ago now lies at x = -1.

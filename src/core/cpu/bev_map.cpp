@@ -18,8 +18,9 @@ std::vector<int32_t> groundPixels(const ScanImage& scan) {
 // Each ground pixel's cell is found once, as it is offered; a pixel outside the map offers to cell -1,
 // which fillGroundMap() passes over, so the offers to cells come in the pixels' order.
 void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pixels, const BevProjection& projection,
-                    float same_surface_distance, std::vector<GroundOffer>& offers, BevImage& ground) {
+                    float same_surface_distance, GroundMapScratch& scratch, BevImage& ground) {
   const SphericalImage& image = scan.image;
+  std::vector<GroundOffer>& offers = scratch.offers;
   offers.resize(ground_pixels.size());
   parallelFor(ground_pixels.size(), [&](size_t i) {
     const int32_t pixel = ground_pixels[i];
@@ -32,14 +33,29 @@ void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pi
     offer.stamp = image.stamp[pixel];
     offer.source = static_cast<uint32_t>(pixel);
   });
-  fillGroundMap(offers, same_surface_distance, ground);
+  fillGroundMap(same_surface_distance, scratch, ground);
 }
 
-void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map) {
+namespace {
+
+// How many offers ahead the serial fill asks for a grid cell. The grid (millions of cells) is far larger
+// than the caches and the offers visit it nearly at random, so each lookup would wait for memory; asked
+// this far ahead, the cell is in the cache when its offer comes.
+constexpr size_t kCellPrefetchDistance = 48;
+
+}  // namespace
+
+void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
+  const std::vector<GroundOffer>& offers = scratch.offers;
   map.clear();
   // Round 1: the closest offer's range per cell. A cell takes the next slot at its first offer.
-  std::vector<int32_t> slot_of_offer(offers.size());
+  std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
+  slot_of_offer.resize(offers.size());
   for (size_t i = 0; i < offers.size(); ++i) {
+    if (i + kCellPrefetchDistance < offers.size()) {
+      const int32_t ahead = offers[i + kCellPrefetchDistance].cell;
+      if (ahead >= 0) __builtin_prefetch(&map.point_of_cell[ahead], 1);
+    }
     const GroundOffer& offer = offers[i];
     if (offer.cell < 0) continue;
     int32_t& slot = map.point_of_cell[offer.cell];
@@ -53,8 +69,11 @@ void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_di
     slot_of_offer[i] = slot;
   }
   // Round 2: the oldest offer on that surface.
-  std::vector<ClosestKey> oldest(map.cell.size(), kNoClosestKey);
-  std::vector<const GroundOffer*> winners(map.cell.size(), nullptr);
+  const size_t slots = map.cell.size();
+  std::vector<ClosestKey>& oldest = scratch.oldest;
+  std::vector<int32_t>& winner = scratch.winner;
+  oldest.assign(slots, kNoClosestKey);
+  winner.resize(slots);
   for (size_t i = 0; i < offers.size(); ++i) {
     const GroundOffer& offer = offers[i];
     if (offer.cell < 0) continue;
@@ -63,16 +82,17 @@ void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_di
     const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
     if (key < oldest[slot]) {
       oldest[slot] = key;
-      winners[slot] = &offer;
+      winner[slot] = static_cast<int32_t>(i);
     }
   }
-  map.vertex.resize(map.cell.size());
-  map.stamp.resize(map.cell.size());
-  for (size_t slot = 0; slot < map.cell.size(); ++slot) {
-    map.vertex[slot] = winners[slot]->vertex;
-    map.range[slot] = winners[slot]->range;
-    map.stamp[slot] = winners[slot]->stamp;
-  }
+  map.vertex.resize(slots);
+  map.stamp.resize(slots);
+  parallelFor(slots, [&](size_t slot) {
+    const GroundOffer& offer = offers[winner[slot]];
+    map.vertex[slot] = offer.vertex;
+    map.range[slot] = offer.range;
+    map.stamp[slot] = offer.stamp;
+  });
 }
 
 void GroundNormalCache::reset(size_t points) {

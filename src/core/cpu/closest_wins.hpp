@@ -20,15 +20,25 @@ class ClosestWins {
     for (size_t i = 0; i < pixels; ++i) keys_[i].store(kNoClosestKey, std::memory_order_relaxed);
   }
 
+  // Whether the offers until the next call come from one thread only (runsAlone()). A single writer
+  // keeps the smaller key with a plain compare and store: the compare-and-swap's locked instruction,
+  // which also waits for every store before it to drain, is then the loop's largest cost.
+  void setSingleWriter(bool single) { single_writer_ = single; }
+
   void offer(size_t pixel, float range, uint32_t source) { offerKey(pixel, closestWinsKey(range, source)); }
   // The smaller key stays.
   void offerKey(size_t pixel, ClosestKey key) {
     ClosestKey current = keys_[pixel].load(std::memory_order_relaxed);
+    if (single_writer_) {
+      if (key < current) keys_[pixel].store(key, std::memory_order_relaxed);
+      return;
+    }
     while (key < current && !keys_[pixel].compare_exchange_weak(current, key, std::memory_order_relaxed)) {
     }
   }
 
-  float range(size_t pixel) const { return closestWinsRange(keys_[pixel].load(std::memory_order_relaxed)); }
+  // The pixel's key so far (kNoClosestKey: no offer).
+  ClosestKey key(size_t pixel) const { return keys_[pixel].load(std::memory_order_relaxed); }
   // The pixel's key (kNoClosestKey: no offer), leaving the pixel empty. Only once every offer is in, and
   // by one thread per pixel.
   ClosestKey take(size_t pixel) {
@@ -39,6 +49,7 @@ class ClosestWins {
 
  private:
   std::unique_ptr<std::atomic<ClosestKey>[]> keys_;
+  bool single_writer_ = false;
 };
 
 }  // namespace elo::cpu

@@ -38,7 +38,7 @@ class CpuBackend final : public Backend {
   SweepVelocity scan_velocity_{};
   std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
   std::vector<int32_t> ground_pixels_;  // as labelled; the ground map is built (and rebuilt) from them
-  std::vector<GroundOffer> ground_offers_;  // the ground map's scratch
+  GroundMapScratch ground_scratch_;  // the scan's and the model's ground maps' scratch
   BevImage scan_ground_;
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_

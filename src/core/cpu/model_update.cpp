@@ -4,6 +4,7 @@
 // stays, and points older than tau_w go. Only three 2D maps are kept (vertex and normal maps of the SRI,
 // vertex map of the BEV), so memory never grows. The per-point rules are shared with the CUDA backend
 // (model_update.hpp).
+#include <algorithm>
 #include <vector>
 
 #include "core/common/eigen_interop.hpp"
@@ -16,25 +17,24 @@ namespace elo::cpu {
 void SphericalFusionScratch::resize(size_t pixels) {
   closest.resize(pixels);
   oldest.resize(pixels);
-  moved_pixel.resize(pixels);
-  moved_range.resize(pixels);
+  moved.resize(pixels);
+  scan_key.resize(pixels);
 }
 
 namespace {
 
-// Moves model pixel `pixel` into the scan's frame and notes where it lands: -1 when it is not offered
-// (empty, no normal, expired, or out of the image).
-void moveModelPoint(const SphericalImage& model, size_t pixel, const Rigid3f& scan_from_model,
-                    const SphericalProjection& projection, const ModelFusion& fusion, SphericalFusionScratch& scratch) {
-  scratch.moved_pixel[pixel] = -1;
-  if (!model.occupied(pixel) || !model.hasNormal(pixel)) return;
-  if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return;
+// Model pixel `pixel` moved into the scan's frame: where it lands, pixel -1 when it is not offered (empty,
+// no normal, expired, or out of the image).
+SphericalFusionScratch::Moved moveModelPoint(const SphericalImage& model, size_t pixel, const Rigid3f& scan_from_model,
+                                             const SphericalProjection& projection, const ModelFusion& fusion) {
+  constexpr SphericalFusionScratch::Moved kNotOffered{-1, 0.0f};
+  if (!model.occupied(pixel) || !model.hasNormal(pixel)) return kNotOffered;
+  if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return kNotOffered;
   const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
   int row = 0;
   int col = 0;
-  if (!projection.pixelOf(moved, row, col)) return;
-  scratch.moved_pixel[pixel] = row * projection.cols + col;
-  scratch.moved_range[pixel] = norm(moved);
+  if (!projection.pixelOf(moved, row, col)) return kNotOffered;
+  return {row * projection.cols + col, norm(moved)};
 }
 
 }  // namespace
@@ -45,36 +45,43 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
   const uint32_t pixels = static_cast<uint32_t>(model.pixelCount());
   const SphericalImage& observed = scan.image;
-  // Calls offer(pixel, range, stamp, source) for the model point at `pixel`, moved (moveModelPoint()
-  // must have run), and for the scan point at `pixel` if it joins the model.
-  const auto offersFrom = [&](size_t pixel, const auto& offer) {
-    const int32_t target = scratch.moved_pixel[pixel];
-    if (target >= 0) offer(target, scratch.moved_range[pixel], model.stamp[pixel], static_cast<uint32_t>(pixel));
-    if (joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))) {
-      offer(pixel, observed.range[pixel], observed.stamp[pixel], scanSource(static_cast<uint32_t>(pixel), pixels));
-    }
-  };
-
   ClosestWins& closest = scratch.closest;
   ClosestWins& oldest = scratch.oldest;
-  // Round 1 moves each model point once; round 2 reuses where it landed.
+  std::vector<SphericalFusionScratch::Moved>& moved = scratch.moved;
+  std::vector<ClosestKey>& scan_key = scratch.scan_key;
+  // A pixel's closest key over all its offers: the model's (closest) and the scan's own.
+  const auto closestKey = [&](size_t pixel) { return std::min(closest.key(pixel), scan_key[pixel]); };
+
+  closest.setSingleWriter(runsAlone());
+  oldest.setSingleWriter(runsAlone());
+  // Round 1 moves each model point once and offers it; each scan pixel notes its own offer.
   parallelFor(pixels, [&](size_t pixel) {
-    moveModelPoint(model, pixel, scan_from_model, projection, fusion, scratch);
-    offersFrom(pixel,
-               [&](size_t target, float range, float, uint32_t source) { closest.offer(target, range, source); });
+    moved[pixel] = moveModelPoint(model, pixel, scan_from_model, projection, fusion);
+    if (moved[pixel].pixel >= 0) closest.offer(moved[pixel].pixel, moved[pixel].range, static_cast<uint32_t>(pixel));
+    scan_key[pixel] = joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))
+                          ? closestWinsKey(observed.range[pixel], scanSource(static_cast<uint32_t>(pixel), pixels))
+                          : kNoClosestKey;
   });
+  // Round 2 reuses where each model point landed.
   parallelFor(pixels, [&](size_t pixel) {
-    offersFrom(pixel, [&](size_t target, float range, float observed_at, uint32_t source) {
-      if (onClosestSurface(range, closest.range(target), fusion.same_surface_distance)) {
-        oldest.offerKey(target, oldestWinsKey(observed_at, source));
-      }
-    });
+    const SphericalFusionScratch::Moved& from = moved[pixel];
+    if (from.pixel < 0) return;
+    if (onClosestSurface(from.range, closestWinsRange(closestKey(from.pixel)), fusion.same_surface_distance)) {
+      oldest.offerKey(from.pixel, oldestWinsKey(model.stamp[pixel], static_cast<uint32_t>(pixel)));
+    }
   });
 
-  // Taking each pixel's winners empties both rounds for the next update.
+  // Each pixel's winner: the oldest model offer on the closest surface, or the scan's own if it is on
+  // that surface and older (or of the same age and a lower source). Taking the keys empties both rounds
+  // for the next update.
   parallelFor(pixels, [&](size_t pixel) {
+    const ClosestKey nearest = closestKey(pixel);
     closest.take(pixel);
-    const ClosestKey winner = oldest.take(pixel);
+    ClosestKey winner = oldest.take(pixel);
+    if (scan_key[pixel] != kNoClosestKey &&
+        onClosestSurface(observed.range[pixel], closestWinsRange(nearest), fusion.same_surface_distance)) {
+      winner = std::min(winner, oldestWinsKey(observed.stamp[pixel], scanSource(static_cast<uint32_t>(pixel), pixels)));
+    }
     if (winner == kNoClosestKey) {
       fused.range[pixel] = 0.0f;
       fused.normal[pixel].setZero();
@@ -90,41 +97,38 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
     } else {
       fused.vertex[pixel] = toVec3f(scan_from_model.apply(toFloat3(model.vertex[source])));
       fused.normal[pixel] = toVec3f(scan_from_model.rotate(toFloat3(model.normal[source])));
-      fused.range[pixel] = scratch.moved_range[source];
+      fused.range[pixel] = moved[source].range;
       fused.stamp[pixel] = model.stamp[source];
     }
   });
 }
 
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
-                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused) {
+                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, GroundMapScratch& scratch,
+                     BevImage& fused) {
   const Rigid3f scan_from_model = toRigid3f(model_from_scan.inverse());
-  // Model points move in parallel, each into its own entry (cell -1: not offered); the offered ones are
-  // then gathered in order and the scan's points follow, so the offers keep the order of their sources,
-  // which gives the map's slots.
-  std::vector<GroundOffer> moved(model.size());
-  parallelFor(model.size(), [&](size_t point) {
-    if (!isCurrent(fusion.now, model.stamp[point], fusion.time_window)) return;
-    const Float3 position = scan_from_model.apply(toFloat3(model.vertex[point]));
+  // One offer per source, in the order of the sources: each model point moved (cell -1 when it is not
+  // offered), then the scan's points. The slots of the map follow that order.
+  const uint32_t model_points = static_cast<uint32_t>(model.size());
+  std::vector<GroundOffer>& offers = scratch.offers;
+  offers.resize(model.size() + scan_ground.size());
+  parallelFor(offers.size(), [&](size_t i) {
+    GroundOffer& offer = offers[i];
+    if (i >= model_points) {
+      const size_t point = i - model_points;
+      offer = {scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
+               model_points + static_cast<uint32_t>(point)};
+      return;
+    }
+    offer.cell = -1;
+    if (!isCurrent(fusion.now, model.stamp[i], fusion.time_window)) return;
+    const Float3 position = scan_from_model.apply(toFloat3(model.vertex[i]));
     int row = 0;
     int col = 0;
     if (!projection.cellOf(position, row, col)) return;
-    moved[point] = {row * projection.cols + col, toVec3f(position), model.stamp[point], static_cast<uint32_t>(point)};
+    offer = {row * projection.cols + col, toVec3f(position), model.stamp[i], static_cast<uint32_t>(i)};
   });
-  std::vector<int32_t> offered;
-  parallelSelect(model.size(), [&](size_t point) { return moved[point].cell >= 0; }, offered);
-  const uint32_t model_points = static_cast<uint32_t>(model.size());
-  std::vector<GroundOffer> offers(offered.size() + scan_ground.size());
-  parallelFor(offers.size(), [&](size_t i) {
-    if (i < offered.size()) {
-      offers[i] = moved[offered[i]];
-      return;
-    }
-    const size_t point = i - offered.size();
-    offers[i] = {scan_ground.cell[point], scan_ground.vertex[point], scan_ground.stamp[point],
-                 model_points + static_cast<uint32_t>(point)};
-  });
-  fillGroundMap(offers, fusion.same_surface_distance, fused);
+  fillGroundMap(fusion.same_surface_distance, scratch, fused);
 }
 
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model) {

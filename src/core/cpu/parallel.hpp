@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -111,6 +112,9 @@ void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& select
   tbb::parallel_for(size_t{0}, blocks, write_block);
   writing.afterLoop();
 }
+
+// Whether the loops of the current arena run on one thread only (a backend with `runtime.threads` 1).
+inline bool runsAlone() { return tbb::this_task_arena::max_concurrency() == 1; }
 
 // Runs `body(i)` for every i in [0, count) across the threads of the current arena.
 template <typename Body>

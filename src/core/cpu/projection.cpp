@@ -19,6 +19,7 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
   };
   // Every placed point is kept, so that the winners need not be corrected and deskewed again.
   placed.resize(cloud.points.size());
+  winners.setSingleWriter(runsAlone());
   parallelFor(cloud.points.size(), [&](size_t i) {
     ScanPoint& point = placed[i];
     if (place(i, point)) winners.offer(point.pixel, norm(point.vertex), static_cast<uint32_t>(i));

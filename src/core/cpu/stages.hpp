@@ -70,15 +70,24 @@ struct GroundOffer {
       : cell(to_cell), vertex(point), range(norm(toFloat3(point))), stamp(observed_at), source(from_source) {}
 };
 
+// The offers a ground map is filled with (fillGroundMap()) and the fill's own arrays, kept by the
+// backend so that no frame allocates them again (each fresh allocation costs page faults and zeroing).
+struct GroundMapScratch {
+  std::vector<GroundOffer> offers;     // in the order of their sources
+  std::vector<int32_t> slot_of_offer;  // round 1: the slot of each offer's cell
+  std::vector<ClosestKey> oldest;      // round 2, per slot: the oldest offer's key
+  std::vector<int32_t> winner;         // round 2, per slot: that offer
+};
+
 // bev_map.cpp: the pixels labelled ground, in increasing order.
 std::vector<int32_t> groundPixels(const ScanImage& scan);
 // The BEV map of the ground pixels `ground_pixels` (groundPixels()): per cell, the first pixel on the
-// closest surface (fillGroundMap below). `offers` is scratch.
+// closest surface (fillGroundMap below).
 void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pixels, const BevProjection& projection,
-                    float same_surface_distance, std::vector<GroundOffer>& offers, BevImage& ground);
-// Fills `map` with `offers` by the two rounds of model_update.hpp: each cell keeps the oldest offer on its
-// closest surface. Slots follow the first offer to each cell. Offers to cell -1 are passed over.
-void fillGroundMap(const std::vector<GroundOffer>& offers, float same_surface_distance, BevImage& map);
+                    float same_surface_distance, GroundMapScratch& scratch, BevImage& ground);
+// Fills `map` with `scratch.offers` by the two rounds of model_update.hpp: each cell keeps the oldest offer
+// on its closest surface. Slots follow the first offer to each cell. Offers to cell -1 are passed over.
+void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map);
 
 // Normals of the BEV model, fitted on demand to the model points nearest each associated cell
 // (Sec. III-C.2, groundNormal() of association.hpp) and kept until the model changes. Safe to query from
@@ -113,13 +122,18 @@ TermSums groundSums(const BevImage& scan_ground, const BevImage& model, const Be
 // Results go to `fused`.
 //
 // The spherical update's scratch, kept by the backend to reuse its memory: each pixel's winner of each
-// round (empty between updates, as resize() leaves them), and where each model pixel lands once moved
-// into the scan's frame.
+// round among the model's offers (empty between updates, as resize() leaves them), where each model pixel
+// lands once moved into the scan's frame, and the key each scan pixel offers to itself. A scan pixel
+// offers only to its own pixel, so its offer needs no atomic: the pass that reads the winners adds it.
 struct SphericalFusionScratch {
-  ClosestWins closest;               // round 1: the closest offer
-  ClosestWins oldest;                // round 2: the oldest offer on the closest surface
-  std::vector<int32_t> moved_pixel;  // per model pixel: the pixel it lands on; -1 when it is not offered
-  std::vector<float> moved_range;    // its range there
+  struct Moved {
+    int32_t pixel;  // the pixel a model pixel lands on; -1 when it is not offered
+    float range;    // its range there
+  };
+  ClosestWins closest;                // round 1: the closest model offer
+  ClosestWins oldest;                 // round 2: the oldest model offer on the closest surface
+  std::vector<Moved> moved;           // per model pixel
+  std::vector<ClosestKey> scan_key;   // per scan pixel: its round-1 key, kNoClosestKey when it does not join
 
   void resize(size_t pixels);
 };
@@ -127,7 +141,8 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
                         const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion,
                         SphericalFusionScratch& scratch, SphericalImage& fused);
 void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const BevProjection& projection,
-                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, BevImage& fused);
+                     const Eigen::Isometry3d& model_from_scan, const ModelFusion& fusion, GroundMapScratch& scratch,
+                     BevImage& fused);
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
 
