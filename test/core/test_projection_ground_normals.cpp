@@ -2,9 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <iostream>
+#include <limits>
+#include <random>
 
 #include "analytic_scene.hpp"
+#include "core/cpu/parallel.hpp"
+#include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
 #include "elo/backend.hpp"
 
@@ -109,6 +114,86 @@ TEST(Projection, FastAtan2IsWithinItsErrorBound) {
   }
   EXPECT_LT(worst, 1.2e-5);
   EXPECT_EQ(fastAtan2(0.0f, 0.0f), 0.0f);
+}
+
+#ifdef ELO_PIXEL_LANES
+// The CPU projection finds 8 points' pixels at once; each lane must give what pixelOf() gives, bit for
+// bit: points in every octant, on the axes, on the seam at azimuth -pi, at every scale from inside the
+// minimum range to beyond the maximum, and not finite.
+TEST(Projection, PixelLanesGivePixelOfsPixelsBitForBit) {
+  const Config config;
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<Float3> points = {{0.0f, 0.0f, 0.0f},     {5.0f, 0.0f, 0.0f},   {-5.0f, 0.0f, 0.0f},  {0.0f, 5.0f, 0.0f},
+                                {0.0f, -5.0f, 0.0f},    {0.0f, 0.0f, 5.0f},   {0.0f, 0.0f, -5.0f},  {-10.0f, -0.0f, 0.0f},
+                                {-10.0f, -1e-7f, -1.7f}, {-10.0f, 1e-7f, 1.0f}, {3.0f, 3.0f, 3.0f}, {-3.0f, -3.0f, -3.0f},
+                                {nan, 1.0f, 1.0f},      {1.0f, inf, 1.0f},    {200.0f, 0.0f, 0.0f}, {1.0f, 1.0f, -nan}};
+  std::mt19937 random(17);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> scale(-1.0f, 2.5f);  // 0.1 m to 300 m
+  while (points.size() < 80000) {
+    const float size = std::pow(10.0f, scale(random));
+    points.push_back({size * unit(random), size * unit(random), 0.3f * size * unit(random)});
+  }
+  size_t accepted = 0;
+  for (size_t first = 0; first < points.size(); first += cpu::kPixelLanes) {
+    float x[cpu::kPixelLanes], y[cpu::kPixelLanes], z[cpu::kPixelLanes], range[cpu::kPixelLanes];
+    int rows[cpu::kPixelLanes], cols[cpu::kPixelLanes];
+    for (int lane = 0; lane < cpu::kPixelLanes; ++lane) {
+      x[lane] = points[first + lane].x;
+      y[lane] = points[first + lane].y;
+      z[lane] = points[first + lane].z;
+    }
+    const unsigned lanes = cpu::pixelsOfLanes(projection, x, y, z, rows, cols, range);
+    for (int lane = 0; lane < cpu::kPixelLanes; ++lane) {
+      const Float3& p = points[first + lane];
+      int row = 0;
+      int col = 0;
+      const bool in_image = projection.pixelOf(p, row, col);
+      ASSERT_EQ((lanes >> lane) & 1u, in_image ? 1u : 0u) << p.x << " " << p.y << " " << p.z;
+      if (!in_image) continue;
+      ++accepted;
+      EXPECT_EQ(rows[lane], row) << p.x << " " << p.y << " " << p.z;
+      EXPECT_EQ(cols[lane], col) << p.x << " " << p.y << " " << p.z;
+      const float expected_range = norm(p);
+      EXPECT_EQ(std::memcmp(&range[lane], &expected_range, sizeof(float)), 0) << range[lane] << " " << expected_range;
+    }
+  }
+  // Both outcomes are exercised many times.
+  EXPECT_GT(accepted, points.size() / 8);
+  EXPECT_LT(accepted, points.size() * 7 / 8);
+}
+#endif
+
+// Closest-wins keys taken with plain stores by one writer, or with compare-and-swap by many, keep the
+// same smallest key per pixel, and taking them leaves every pixel empty.
+TEST(Projection, ClosestWinsKeepsTheSmallestKeyWithOneWriterAsWithMany) {
+  constexpr size_t kPixels = 500;
+  std::mt19937 random(3);
+  std::uniform_int_distribution<size_t> pixel_of(0, kPixels - 1);
+  std::uniform_real_distribution<float> range_of(0.5f, 80.0f);
+  std::vector<std::pair<size_t, ClosestKey>> offers;
+  std::vector<ClosestKey> smallest(kPixels, kNoClosestKey);
+  for (uint32_t source = 0; source < 20000; ++source) {
+    const size_t pixel = pixel_of(random);
+    const ClosestKey key = closestWinsKey(range_of(random), source);
+    offers.emplace_back(pixel, key);
+    smallest[pixel] = std::min(smallest[pixel], key);
+  }
+  ASSERT_NE(std::count(smallest.begin(), smallest.end(), kNoClosestKey), static_cast<long>(kPixels));
+  for (const bool single_writer : {true, false}) {
+    cpu::ClosestWins winners;
+    winners.resize(kPixels);
+    winners.setSingleWriter(single_writer);
+    if (single_writer) {
+      for (const auto& [pixel, key] : offers) winners.offerKey(pixel, key);
+    } else {
+      cpu::parallelFor(offers.size(), [&](size_t i) { winners.offerKey(offers[i].first, offers[i].second); });
+    }
+    for (size_t pixel = 0; pixel < kPixels; ++pixel) EXPECT_EQ(winners.take(pixel), smallest[pixel]) << pixel;
+    for (size_t pixel = 0; pixel < kPixels; ++pixel) EXPECT_EQ(winners.key(pixel), kNoClosestKey) << pixel;
+  }
 }
 
 TEST(Projection, ElevationCorrectionRaisesElevationAtConstantRange) {

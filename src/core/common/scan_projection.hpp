@@ -26,6 +26,17 @@ ELO_HOST_DEVICE inline bool scanPointVertex(const ElevationCorrection& correctio
   return deskew.apply(index, point.measured, point.time, point.vertex);
 }
 
+// The row of a point of beam `ring` into `row`: with a driver's ring (not kNoRing) the beam's row
+// (`ring_rows`, `ring_count` entries), which is exact where the elevation of a noisy point is not;
+// otherwise `row`, the row of its elevation, stays. False when the ring is not a known beam or its row is
+// outside the `rows` of the image.
+ELO_HOST_DEVICE inline bool beamRow(int ring, const int* ring_rows, int ring_count, int rows, int& row) {
+  if (ring == kNoRing) return true;
+  if (ring >= ring_count) return false;
+  row = ring_rows[ring];
+  return row >= 0 && row < rows;
+}
+
 // The pixel of cloud point `index` (`raw`), whose vertex is the point after the elevation correction and
 // the deskew. `ring` (or kNoRing) is the driver's beam index: when known, the beam's row (`ring_rows`,
 // `ring_count` entries) is exact where the elevation of a noisy point is not. False for a point that is
@@ -38,11 +49,7 @@ ELO_HOST_DEVICE inline bool scanPointPixel(const SphericalProjection& projection
   int row = 0;
   int col = 0;
   if (!projection.pixelOf(point.vertex, row, col)) return false;
-  if (ring != kNoRing) {
-    if (ring >= ring_count) return false;
-    row = ring_rows[ring];
-    if (row < 0 || row >= projection.rows) return false;
-  }
+  if (!beamRow(ring, ring_rows, ring_count, projection.rows, row)) return false;
   point.pixel = row * projection.cols + col;
   return true;
 }

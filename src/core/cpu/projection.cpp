@@ -3,27 +3,79 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/common/scan_projection.hpp"
 #include "core/cpu/parallel.hpp"
+#include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
+
+namespace {
+
+// The driver's ring of each cloud point, when it gives them, and each ring's row.
+struct RingRows {
+  const uint16_t* ring_of_point;  // null: rows come from the elevation
+  const int* rows;
+  int count;
+
+  int of(size_t point) const { return ring_of_point != nullptr ? ring_of_point[point] : kNoRing; }
+};
+
+// The cloud's points in groups of kPixelLanes: each point corrected, deskewed and timed alone, the group's
+// pixels found together (pixel_lanes.hpp), each placed point offered to its pixel.
+#ifdef ELO_PIXEL_LANES
+template <typename Vertex, typename Offer>
+void placeInGroups(size_t count, const SphericalProjection& projection, const RingRows& rings, const Vertex& vertex,
+                   std::vector<ScanPoint>& placed, const Offer& offer) {
+  parallelFor((count + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
+    const size_t first = group * kPixelLanes;
+    float x[kPixelLanes], y[kPixelLanes], z[kPixelLanes], range[kPixelLanes];
+    int row[kPixelLanes], col[kPixelLanes];
+    unsigned usable = 0;
+    for (int lane = 0; lane < kPixelLanes; ++lane) {
+      const size_t i = first + lane;
+      const bool placed_here = i < count && vertex(i, placed[i]);
+      usable |= placed_here ? 1u << lane : 0u;
+      x[lane] = placed_here ? placed[i].vertex.x : 0.0f;
+      y[lane] = placed_here ? placed[i].vertex.y : 0.0f;
+      z[lane] = placed_here ? placed[i].vertex.z : 0.0f;
+    }
+    const unsigned accepted = usable & pixelsOfLanes(projection, x, y, z, row, col, range);
+    for (int lane = 0; lane < kPixelLanes; ++lane) {
+      if (!(accepted & (1u << lane))) continue;
+      const size_t i = first + lane;
+      if (!beamRow(rings.of(i), rings.rows, rings.count, projection.rows, row[lane])) continue;
+      placed[i].pixel = row[lane] * projection.cols + col[lane];
+      offer(i, range[lane]);
+    }
+  });
+}
+#endif
+
+}  // namespace
 
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
                     std::vector<ScanPoint>& placed, ScanImage& scan) {
   const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
   const bool use_ring = !ring_rows.empty() && cloud.ring.size() == cloud.points.size();
-  const auto place = [&](size_t i, ScanPoint& point) {
-    const int ring = use_ring ? cloud.ring[i] : kNoRing;
-    return scanPointPixel(projection, correction, deskew, static_cast<int>(i), toFloat3(cloud.points[i]), ring,
-                          ring_rows.data(), static_cast<int>(ring_rows.size()), point);
-  };
+  const RingRows rings{use_ring ? cloud.ring.data() : nullptr, ring_rows.data(), static_cast<int>(ring_rows.size())};
   // Every placed point is kept, so that the winners need not be corrected and deskewed again.
   placed.resize(cloud.points.size());
   winners.setSingleWriter(runsAlone());
+  const auto offer = [&](size_t i, float range) { winners.offer(placed[i].pixel, range, static_cast<uint32_t>(i)); };
+#ifdef ELO_PIXEL_LANES
+  placeInGroups(cloud.points.size(), projection, rings, [&](size_t i, ScanPoint& point) {
+    const Float3 raw = toFloat3(cloud.points[i]);
+    return isFinite(raw) && scanPointVertex(correction, deskew, static_cast<int>(i), raw, point);
+  }, placed, offer);
+#else
   parallelFor(cloud.points.size(), [&](size_t i) {
     ScanPoint& point = placed[i];
-    if (place(i, point)) winners.offer(point.pixel, norm(point.vertex), static_cast<uint32_t>(i));
+    if (scanPointPixel(projection, correction, deskew, static_cast<int>(i), toFloat3(cloud.points[i]), rings.of(i),
+                       rings.rows, rings.count, point)) {
+      offer(i, norm(point.vertex));
+    }
   });
+#endif
 
   // Each pixel takes its winner (which empties the pixel for the next scan). The winner's range is the
   // one its key holds: the norm of the same vertex.
