@@ -10,6 +10,7 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/common/model_update.hpp"
 #include "core/cpu/parallel.hpp"
+#include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
@@ -23,18 +24,10 @@ void SphericalFusionScratch::resize(size_t pixels) {
 
 namespace {
 
-// Model pixel `pixel` moved into the scan's frame: where it lands, pixel -1 when it is not offered (empty,
-// no normal, expired, or out of the image).
-SphericalFusionScratch::Moved moveModelPoint(const SphericalImage& model, size_t pixel, const Rigid3f& scan_from_model,
-                                             const SphericalProjection& projection, const ModelFusion& fusion) {
-  constexpr SphericalFusionScratch::Moved kNotOffered{-1, 0.0f};
-  if (!model.occupied(pixel) || !model.hasNormal(pixel)) return kNotOffered;
-  if (!isCurrent(fusion.now, model.stamp[pixel], fusion.time_window)) return kNotOffered;
-  const Float3 moved = scan_from_model.apply(toFloat3(model.vertex[pixel]));
-  int row = 0;
-  int col = 0;
-  if (!projection.pixelOf(moved, row, col)) return kNotOffered;
-  return {row * projection.cols + col, norm(moved)};
+// Whether model pixel `pixel` is offered again: occupied, with a normal, not expired. Where it lands, once
+// moved into the scan's frame, decides whether it is offered to a pixel (in the image) or dropped.
+bool staysInModel(const SphericalImage& model, size_t pixel, const ModelFusion& fusion) {
+  return model.occupied(pixel) && model.hasNormal(pixel) && isCurrent(fusion.now, model.stamp[pixel], fusion.time_window);
 }
 
 }  // namespace
@@ -54,13 +47,27 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
 
   closest.setSingleWriter(runsAlone());
   oldest.setSingleWriter(runsAlone());
-  // Round 1 moves each model point once and offers it; each scan pixel notes its own offer.
-  parallelFor(pixels, [&](size_t pixel) {
-    moved[pixel] = moveModelPoint(model, pixel, scan_from_model, projection, fusion);
-    if (moved[pixel].pixel >= 0) closest.offer(moved[pixel].pixel, moved[pixel].range, static_cast<uint32_t>(pixel));
-    scan_key[pixel] = joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))
-                          ? closestWinsKey(observed.range[pixel], scanSource(static_cast<uint32_t>(pixel), pixels))
-                          : kNoClosestKey;
+  // Round 1 moves each model point once and offers it (the pixels of kPixelLanes moved points found at
+  // once); each scan pixel notes its own offer.
+  parallelFor((pixels + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
+    const size_t first = group * kPixelLanes;
+    for (size_t pixel = first; pixel < first + kPixelLanes && pixel < pixels; ++pixel) {
+      moved[pixel].pixel = -1;
+      scan_key[pixel] = joinsModel(scan.label[pixel], toFloat3(observed.normal[pixel]))
+                            ? closestWinsKey(observed.range[pixel], scanSource(static_cast<uint32_t>(pixel), pixels))
+                            : kNoClosestKey;
+    }
+    pixelsOfGroup(
+        projection, first, pixels,
+        [&](size_t pixel, Float3& position) {
+          if (!staysInModel(model, pixel, fusion)) return false;
+          position = scan_from_model.apply(toFloat3(model.vertex[pixel]));
+          return true;
+        },
+        [&](size_t pixel, int row, int col, float range) {
+          moved[pixel] = {row * projection.cols + col, range};
+          closest.offer(moved[pixel].pixel, range, static_cast<uint32_t>(pixel));
+        });
   });
   // Round 2 reuses where each model point landed.
   parallelFor(pixels, [&](size_t pixel) {

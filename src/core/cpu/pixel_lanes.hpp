@@ -1,21 +1,28 @@
-// SphericalProjection::pixelOf() for 8 points at once, with AVX. Per point, pixelOf() is a chain of
-// divisions and square roots with branches on the point's octant that the branch predictor cannot
-// learn; 8 lanes share one chain and the branches become selects. Each lane performs pixelOf()'s float
-// operations in its order, so it gives the same pixel bit for bit (test_projection_ground_normals.cpp
-// checks it against pixelOf() itself). Without AVX the projection stays with pixelOf() point by point.
+// SphericalProjection::pixelOf() for 8 points at once, with AVX: the projection's and the model update's
+// loops over points and pixels. Per point, pixelOf() is a chain of divisions and square roots with
+// branches on the point's octant that the branch predictor cannot learn; 8 lanes share one chain and the
+// branches become selects. Each lane performs pixelOf()'s float operations in its order, so it gives the
+// same pixel bit for bit (test_projection_ground_normals.cpp checks it against pixelOf() itself).
+// Without AVX, pixelsOfGroup() calls pixelOf() point by point.
 #pragma once
+
+#include <cstddef>
+
+#include "elo/device_types.hpp"
+#include "elo/projections.hpp"
 
 #if defined(__AVX__)
 #define ELO_PIXEL_LANES 1
 #include <immintrin.h>
 
 #include <cmath>
-
-#include "elo/projections.hpp"
+#endif
 
 namespace elo::cpu {
 
 constexpr int kPixelLanes = 8;
+
+#ifdef ELO_PIXEL_LANES
 
 namespace lanes {
 
@@ -84,6 +91,38 @@ inline unsigned pixelsOfLanes(const SphericalProjection& projection, const float
   return static_cast<unsigned>(_mm256_movemask_ps(accepted));
 }
 
-}  // namespace elo::cpu
+#endif  // ELO_PIXEL_LANES
 
-#endif  // __AVX__
+// The pixels of items [first, first + kPixelLanes) below `count`: `point(i, p)` gives item i's point p
+// (false: it has none); each point pixelOf() accepts goes to `found(i, row, col, range)`, range its norm().
+template <typename Point, typename Found>
+void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t count, const Point& point,
+                   const Found& found) {
+#ifdef ELO_PIXEL_LANES
+  float x[kPixelLanes], y[kPixelLanes], z[kPixelLanes], range[kPixelLanes];
+  int row[kPixelLanes], col[kPixelLanes];
+  unsigned usable = 0;
+  for (int lane = 0; lane < kPixelLanes; ++lane) {
+    const size_t i = first + lane;
+    Float3 p{0.0f, 0.0f, 0.0f};
+    const bool has_point = i < count && point(i, p);
+    usable |= has_point ? 1u << lane : 0u;
+    x[lane] = has_point ? p.x : 0.0f;
+    y[lane] = has_point ? p.y : 0.0f;
+    z[lane] = has_point ? p.z : 0.0f;
+  }
+  const unsigned accepted = usable & pixelsOfLanes(projection, x, y, z, row, col, range);
+  for (int lane = 0; lane < kPixelLanes; ++lane) {
+    if (accepted & (1u << lane)) found(first + lane, row[lane], col[lane], range[lane]);
+  }
+#else
+  for (size_t i = first; i < first + kPixelLanes && i < count; ++i) {
+    Float3 p;
+    int row = 0;
+    int col = 0;
+    if (point(i, p) && projection.pixelOf(p, row, col)) found(i, row, col, norm(p));
+  }
+#endif
+}
+
+}  // namespace elo::cpu

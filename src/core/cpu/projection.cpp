@@ -19,37 +19,6 @@ struct RingRows {
   int of(size_t point) const { return ring_of_point != nullptr ? ring_of_point[point] : kNoRing; }
 };
 
-// The cloud's points in groups of kPixelLanes: each point corrected, deskewed and timed alone, the group's
-// pixels found together (pixel_lanes.hpp), each placed point offered to its pixel.
-#ifdef ELO_PIXEL_LANES
-template <typename Vertex, typename Offer>
-void placeInGroups(size_t count, const SphericalProjection& projection, const RingRows& rings, const Vertex& vertex,
-                   std::vector<ScanPoint>& placed, const Offer& offer) {
-  parallelFor((count + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
-    const size_t first = group * kPixelLanes;
-    float x[kPixelLanes], y[kPixelLanes], z[kPixelLanes], range[kPixelLanes];
-    int row[kPixelLanes], col[kPixelLanes];
-    unsigned usable = 0;
-    for (int lane = 0; lane < kPixelLanes; ++lane) {
-      const size_t i = first + lane;
-      const bool placed_here = i < count && vertex(i, placed[i]);
-      usable |= placed_here ? 1u << lane : 0u;
-      x[lane] = placed_here ? placed[i].vertex.x : 0.0f;
-      y[lane] = placed_here ? placed[i].vertex.y : 0.0f;
-      z[lane] = placed_here ? placed[i].vertex.z : 0.0f;
-    }
-    const unsigned accepted = usable & pixelsOfLanes(projection, x, y, z, row, col, range);
-    for (int lane = 0; lane < kPixelLanes; ++lane) {
-      if (!(accepted & (1u << lane))) continue;
-      const size_t i = first + lane;
-      if (!beamRow(rings.of(i), rings.rows, rings.count, projection.rows, row[lane])) continue;
-      placed[i].pixel = row[lane] * projection.cols + col[lane];
-      offer(i, range[lane]);
-    }
-  });
-}
-#endif
-
 }  // namespace
 
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
@@ -61,21 +30,22 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
   // Every placed point is kept, so that the winners need not be corrected and deskewed again.
   placed.resize(cloud.points.size());
   winners.setSingleWriter(runsAlone());
-  const auto offer = [&](size_t i, float range) { winners.offer(placed[i].pixel, range, static_cast<uint32_t>(i)); };
-#ifdef ELO_PIXEL_LANES
-  placeInGroups(cloud.points.size(), projection, rings, [&](size_t i, ScanPoint& point) {
-    const Float3 raw = toFloat3(cloud.points[i]);
-    return isFinite(raw) && scanPointVertex(correction, deskew, static_cast<int>(i), raw, point);
-  }, placed, offer);
-#else
-  parallelFor(cloud.points.size(), [&](size_t i) {
-    ScanPoint& point = placed[i];
-    if (scanPointPixel(projection, correction, deskew, static_cast<int>(i), toFloat3(cloud.points[i]), rings.of(i),
-                       rings.rows, rings.count, point)) {
-      offer(i, norm(point.vertex));
-    }
+  // Each point is corrected, deskewed and timed alone; the pixels of kPixelLanes points are found at once.
+  parallelFor((cloud.points.size() + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
+    pixelsOfGroup(
+        projection, group * kPixelLanes, cloud.points.size(),
+        [&](size_t i, Float3& vertex) {
+          const Float3 raw = toFloat3(cloud.points[i]);
+          if (!isFinite(raw) || !scanPointVertex(correction, deskew, static_cast<int>(i), raw, placed[i])) return false;
+          vertex = placed[i].vertex;
+          return true;
+        },
+        [&](size_t i, int row, int col, float range) {
+          if (!beamRow(rings.of(i), rings.rows, rings.count, projection.rows, row)) return;
+          placed[i].pixel = row * projection.cols + col;
+          winners.offer(placed[i].pixel, range, static_cast<uint32_t>(i));
+        });
   });
-#endif
 
   // Each pixel takes its winner (which empties the pixel for the next scan). The winner's range is the
   // one its key holds: the norm of the same vertex.
