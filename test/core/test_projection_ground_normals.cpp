@@ -145,7 +145,8 @@ TEST(Projection, PixelLanesGivePixelOfsPixelsBitForBit) {
       y[lane] = points[first + lane].y;
       z[lane] = points[first + lane].z;
     }
-    const unsigned lanes = cpu::pixelsOfLanes(projection, x, y, z, rows, cols, range);
+    const unsigned lanes = cpu::pixelsOfLanes(projection, _mm256_loadu_ps(x), _mm256_loadu_ps(y), _mm256_loadu_ps(z),
+                                              rows, cols, range);
     for (int lane = 0; lane < cpu::kPixelLanes; ++lane) {
       const Float3& p = points[first + lane];
       int row = 0;

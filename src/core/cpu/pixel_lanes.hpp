@@ -53,14 +53,11 @@ inline __m256 fastAtan2(__m256 y, __m256 x) {
 
 }  // namespace lanes
 
-// pixelOf() of the points (x[k], y[k], z[k]), k < kPixelLanes: bit k of the result is set when it accepts
-// point k, whose row and col it then gave; range[k] is the point's norm() (the square root of pixelOf()'s
-// squared range, summed in norm()'s order), for every lane.
-inline unsigned pixelsOfLanes(const SphericalProjection& projection, const float* x, const float* y, const float* z,
-                              int* row, int* col, float* range) {
-  const __m256 px = _mm256_loadu_ps(x);
-  const __m256 py = _mm256_loadu_ps(y);
-  const __m256 pz = _mm256_loadu_ps(z);
+// pixelOf() of the points (px[k], py[k], pz[k]), k < kPixelLanes: bit k of the result is set when it
+// accepts point k, whose row and col it then gave; range[k] is the point's norm() (the square root of
+// pixelOf()'s squared range, summed in norm()'s order), for every lane.
+inline unsigned pixelsOfLanes(const SphericalProjection& projection, __m256 px, __m256 py, __m256 pz, int* row,
+                              int* col, float* range) {
   const __m256 horizontal_squared = _mm256_add_ps(_mm256_mul_ps(px, px), _mm256_mul_ps(py, py));
   const __m256 range_squared = _mm256_add_ps(horizontal_squared, _mm256_mul_ps(pz, pz));
   _mm256_storeu_ps(range, _mm256_sqrt_ps(range_squared));
@@ -111,7 +108,11 @@ void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t c
     y[lane] = has_point ? p.y : 0.0f;
     z[lane] = has_point ? p.z : 0.0f;
   }
-  const unsigned accepted = usable & pixelsOfLanes(projection, x, y, z, row, col, range);
+  // Lanes set from registers: a vector load of the 8 floats just stored one by one would wait for them.
+  const unsigned accepted =
+      usable & pixelsOfLanes(projection, _mm256_setr_ps(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]),
+                             _mm256_setr_ps(y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7]),
+                             _mm256_setr_ps(z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]), row, col, range);
   for (int lane = 0; lane < kPixelLanes; ++lane) {
     if (accepted & (1u << lane)) found(first + lane, row[lane], col[lane], range[lane]);
   }
