@@ -216,6 +216,9 @@ class Report {
       std::printf(", %zu degenerate (the motion prior kept along what the scan did not constrain)",
                   odometry.degenerateCount());
     }
+    if (odometry.sensorMisfitCount() > 0) {
+      std::printf(", %zu not fitting the sensor model (the warning above)", odometry.sensorMisfitCount());
+    }
     std::printf("\n%-22s %10s %10s\n", "stage (ms)", "mean", "median");
     const std::pair<const char*, const std::vector<double>*> rows[] = {
         {"spherical projection", &projection_}, {"feature extraction", &features_},
@@ -326,6 +329,9 @@ class ScanLoop {
   elo::FrameResult processScan(size_t scan, const ScanRead& read) {
     if (!read.cloud) return skipUnreadable(scan, read);
     const elo::FrameResult result = odometry_.process(*read.cloud);
+    if (!result.sensor_warning.empty() && odometry_.sensorMisfitCount() == 1) {  // the first; the summary counts them
+      std::fprintf(stderr, "\nscan %zu: warning: %s\n", scan, result.sensor_warning.c_str());
+    }
     if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
     if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
     if (result.gap_restart) {

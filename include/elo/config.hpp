@@ -23,6 +23,9 @@ enum class BackendKind { cpu, cuda };
 // instantaneous), the cloud's own per-point times (PointCloud::time), or the point's azimuth along the
 // sensor's rotation (sensor.rotation_rate_hz, sensor.clockwise, sensor.sweep_start_azimuth_deg).
 enum class TimeSource { none, field, azimuth };
+// Which beam a driver's `ring` 0 is: velodyne_pointcloud counts rings up from the lowest beam, ouster_ros
+// down from the highest.
+enum class RingZero { bottom, top };
 
 // Sec. III-B.1, Eq. 3-4: the sensor and its spherical range image.
 struct SensorConfig {
@@ -38,10 +41,12 @@ struct SensorConfig {
   // Rotates every point's elevation up by this angle. KITTI's HDL-64E intrinsics bend the scan; the
   // paper (after IMLS-SLAM) corrects by 0.195 deg. Zero for any other data.
   double elevation_correction_deg = 0.0;
-  // Nominal elevation of each beam, top to bottom; the simulator fires these and the `ring` field of a
-  // driver indexes them. Empty means `beam_count` beams spread evenly over the field of view.
+  // Nominal elevation of each beam, top to bottom; the simulator fires these. Empty means `beam_count`
+  // beams spread evenly over the field of view.
   std::vector<double> beam_elevations_deg = hdl64BeamElevations();
   int beam_count = 64;
+  // How the `ring` field numbers the beams (ringElevations()); the simulator numbers them the same way.
+  RingZero ring_zero = RingZero::bottom;
   int azimuth_steps = 2083;        // firings per revolution (simulator)
   // Revolutions per second: the simulator's sweep, the times deskew.time_source azimuth gives, and the
   // window per-point times must lie in (one sweep either side of the stamp, with a margin).

@@ -41,6 +41,8 @@ struct FrameResult {
   int deskew_rounds = 0;
   std::string time_warning;
   size_t points_without_time = 0;  // points dropped for a time outside the sweep
+  // Why much of the scan does not fit the configured sensor (SensorFit::warning()); empty when it fits.
+  std::string sensor_warning;
   StageTimes times;
 };
 
@@ -84,6 +86,8 @@ class Odometry {
   size_t degenerateCount() const { return degenerate_; }
   // Scans whose per-point times were not used, or not all used, by FrameResult::time_warning.
   const std::map<std::string, size_t>& timeWarningCounts() const { return time_warnings_; }
+  // Scans with a FrameResult::sensor_warning.
+  size_t sensorMisfitCount() const { return sensor_misfits_; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -97,6 +101,8 @@ class Odometry {
   // process() but for the total time and the end of the prefetch.
   FrameResult processScan(const PointCloud& cloud);
   FrameResult skip(const std::string& reason);
+  // SensorFit::warning() of about kSensorFitSamples of the cloud's points, counted when not empty.
+  std::string sensorWarning(const PointCloud& cloud);
   // Forgets the model and the motion but keeps the pose: the next scan continues the trajectory from it.
   void restartModel();
   // `stamp` - the first scan's stamp, in whole nanoseconds as ROS stamps count time. The intervals the
@@ -143,6 +149,7 @@ class Odometry {
   size_t degenerate_ = 0;
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> time_warnings_;
+  size_t sensor_misfits_ = 0;
 };
 
 }  // namespace elo

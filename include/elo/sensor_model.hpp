@@ -18,5 +18,9 @@ inline Vec3f correctElevation(const Vec3f& p, float cos_angle, float sin_angle) 
 
 // Nominal elevation (rad) of each beam, top to bottom, from the config's table or an even spread.
 std::vector<float> beamElevations(const SensorConfig& sensor);
+// The same, indexed by the ring a driver gives each beam (sensor.ring_zero).
+std::vector<float> ringElevations(const SensorConfig& sensor);
+// The ring a driver gives beam `beam` of beamElevations() (sensor.ring_zero).
+int ringOfBeam(const SensorConfig& sensor, int beam);
 
 }  // namespace elo

@@ -110,6 +110,9 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("sensor.beam_elevations_deg", s.beam_elevations_deg,
            "nominal beam elevations top to bottom, deg; empty = beam_count beams spread evenly"),
       bindField("sensor.beam_count", s.beam_count, "number of beams"),
+      bindChoice("sensor.ring_zero", s.ring_zero, {{RingZero::bottom, "bottom"}, {RingZero::top, "top"}},
+                 "the beam a cloud's ring 0 is: bottom (velodyne_pointcloud counts up from the lowest beam) or top "
+                 "(ouster_ros counts down from the highest)"),
       bindField("sensor.azimuth_steps", s.azimuth_steps, "firings per revolution (simulator)"),
       bindField("sensor.rotation_rate_hz", s.rotation_rate_hz,
                 "revolutions per second (simulator, azimuth times, window of per-point times)"),

@@ -1,5 +1,7 @@
 #include "elo/sensor_model.hpp"
 
+#include <algorithm>
+
 namespace elo {
 
 namespace {
@@ -47,6 +49,17 @@ std::vector<float> beamElevations(const SensorConfig& sensor) {
     const double degrees = sensor.fov_up_deg - span * (beam + 0.5) / sensor.beam_count;
     elevations.push_back(static_cast<float>(degrees * kDegToRad));
   }
+  return elevations;
+}
+
+int ringOfBeam(const SensorConfig& sensor, int beam) {
+  const int beams = static_cast<int>(beamElevations(sensor).size());
+  return sensor.ring_zero == RingZero::top ? beam : beams - 1 - beam;
+}
+
+std::vector<float> ringElevations(const SensorConfig& sensor) {
+  std::vector<float> elevations = beamElevations(sensor);
+  if (sensor.ring_zero == RingZero::bottom) std::reverse(elevations.begin(), elevations.end());
   return elevations;
 }
 

@@ -24,6 +24,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(failed_registrations, "registrations failed");
   add(restarts, "odometry restarts");
   add(time_warnings, "scans with unusable per-point times");
+  add(sensor_misfits, "scans not fitting the sensor.* settings");
   return text.str();
 }
 
@@ -78,6 +79,11 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
     ++time_warnings_[result.time_warning];
     ++window_.time_warnings;
   }
+  if (!result.sensor_warning.empty()) {
+    ++sensor_misfits_;
+    ++window_.sensor_misfits;
+    last_sensor_warning_ = result.sensor_warning;
+  }
   if (result.registration.iterations > 0) last_registration_ = result.registration;
 }
 
@@ -122,6 +128,8 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
   for (const auto& [reason, count] : restarts_) status.add("odometry restarts: " + reason, count);
   for (const auto& [reason, count] : time_warnings_) status.add("per-point times: " + reason, count);
+  status.add("scans not fitting the sensor model", sensor_misfits_);
+  if (sensor_misfits_ > 0) status.add("sensor model: latest misfit", last_sensor_warning_);
 
   window_start_ = now;
   window_ = Window();

@@ -30,8 +30,9 @@ class PipelineStatistics {
   void odometryRestarted(const std::string& reason);
 
   // Fills `status` and starts a new window. WARN when the window saw no cloud at all, or a drop,
-  // rejection, skip, restart, failed registration or scan whose per-point times were not (all) usable
-  // (elo::FrameResult::time_warning), and while the latest scan is degenerate.
+  // rejection, skip, restart, failed registration, scan whose per-point times were not (all) usable
+  // (elo::FrameResult::time_warning) or scan that does not fit the sensor model
+  // (elo::FrameResult::sensor_warning), and while the latest scan is degenerate.
   void report(diagnostic_updater::DiagnosticStatusWrapper& status);
 
  private:
@@ -46,6 +47,7 @@ class PipelineStatistics {
     size_t failed_registrations = 0;
     size_t restarts = 0;
     size_t time_warnings = 0;
+    size_t sensor_misfits = 0;
     double processing_ms_sum = 0.0;
     double processing_ms_max = 0.0;
     double latency_ms_sum = 0.0;
@@ -67,6 +69,8 @@ class PipelineStatistics {
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> restarts_;
   std::map<std::string, size_t> time_warnings_;  // elo::FrameResult::time_warning
+  size_t sensor_misfits_ = 0;                     // scans with an elo::FrameResult::sensor_warning
+  std::string last_sensor_warning_;
   elo::RegistrationResult last_registration_;
 };
 

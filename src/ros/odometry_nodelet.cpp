@@ -177,6 +177,7 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   if (!result.time_warning.empty()) {
     NODELET_WARN_THROTTLE(kWarningPeriod, "per-point times: %s (deskew.time_source)", result.time_warning.c_str());
   }
+  if (!result.sensor_warning.empty()) NODELET_WARN_THROTTLE(kWarningPeriod, "%s", result.sensor_warning.c_str());
   if (!result.processed) {
     lock.unlock();
     statistics_.scanSkipped(result.skip_reason);

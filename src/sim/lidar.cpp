@@ -190,7 +190,7 @@ SimulatedScan Lidar::addNoise(const std::vector<Return>& returns, double start, 
       if (range < sensor_.min_range || range > sensor_.max_range) continue;
       scan.cloud.points.push_back((range * direction(beam, step)).cast<float>());
       scan.cloud.intensity.push_back(result.intensity);
-      scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
+      scan.cloud.ring.push_back(static_cast<uint16_t>(ringOfBeam(sensor_, beam)));
       if (with_times) scan.cloud.time.push_back(static_cast<float>(firingTime(step)));
       scan.surface.push_back(result.kind);
     }

@@ -147,7 +147,7 @@ ScanWithTruth scanSceneFrom(const Scene& scene, const SensorConfig& sensor, cons
       if (hit.surface == Surface::none || hit.range > sensor.max_range || hit.range < sensor.min_range) continue;
       const double range = hit.range + (range_noise > 0.0 ? range_noise * noise() : 0.0);
       scan.cloud.points.push_back((local * range).cast<float>());
-      scan.cloud.ring.push_back(static_cast<uint16_t>(beam));
+      scan.cloud.ring.push_back(static_cast<uint16_t>(ringOfBeam(sensor, static_cast<int>(beam))));
       scan.step.push_back(step);
       scan.surface.push_back(hit.surface);
       scan.normal.push_back(rotation.transpose() * hit.normal);

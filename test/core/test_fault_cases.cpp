@@ -150,5 +150,41 @@ TEST(FaultCases, TwoMillionPointScanIsProcessedInBoundedTime) {
   std::printf("%zu points processed in %.3f s (projection %.0f ms)\n", dense.size(), seconds, result.times.projection);
 }
 
+// Scans of a 16-beam sensor (+-15 deg) under the HDL-64E defaults (+3 .. -25 deg): the upper beams fall
+// off the image. Each scan is still processed, with a warning that names the field of view and the
+// settings, counted; under the sensor's own settings there is none.
+TEST(FaultCases, AnotherSensorsScansWarnThatTheyDoNotFitTheSensorModel) {
+  SensorConfig sixteen_beams;
+  sixteen_beams.name = "sixteen";
+  sixteen_beams.fov_up_deg = 15.0;
+  sixteen_beams.fov_down_deg = -15.0;
+  sixteen_beams.beam_elevations_deg.clear();
+  sixteen_beams.beam_count = 16;
+  sixteen_beams.image_height = 16;
+  const auto scan = [&](int frame) {
+    return test::scanScene(test::streetScene(), sixteen_beams, streetPose(frame), kScanPeriod * frame).cloud;
+  };
+  Odometry misconfigured{Config()};
+  for (int frame = 0; frame < 3; ++frame) {
+    const FrameResult result = misconfigured.process(scan(frame));
+    EXPECT_NE(result.sensor_warning.find("above its field of view's top at +3.0 deg"), std::string::npos)
+        << "frame " << frame << ": '" << result.sensor_warning << "'";
+  }
+  EXPECT_EQ(misconfigured.sensorMisfitCount(), 3u);
+
+  Config own;
+  own.sensor = sixteen_beams;
+  Odometry configured{own};
+  for (int frame = 0; frame < 3; ++frame) EXPECT_EQ(configured.process(scan(frame)).sensor_warning, "");
+  EXPECT_EQ(configured.sensorMisfitCount(), 0u);
+}
+
+// The street's HDL-64E scans fit the defaults.
+TEST(FaultCases, TheSensorsOwnScansFitItsModel) {
+  Odometry odometry{Config()};
+  for (int frame = 0; frame < 3; ++frame) EXPECT_EQ(odometry.process(streetScan(frame)).sensor_warning, "");
+  EXPECT_EQ(odometry.sensorMisfitCount(), 0u);
+}
+
 }  // namespace
 }  // namespace elo

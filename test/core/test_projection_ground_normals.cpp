@@ -95,7 +95,7 @@ TEST(Projection, RingFieldSelectsTheBeamsRow) {
   Projected p = projectStreet(config, true);
   const ScanImage& scan = p.backend->scan();
   const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
-  const std::vector<float> elevations = beamElevations(config.sensor);
+  const std::vector<float> elevations = ringElevations(config.sensor);
   for (size_t pixel = 0; pixel < scan.image.pixelCount(); ++pixel) {
     if (!scan.image.occupied(pixel)) continue;
     const uint16_t ring = p.truth.cloud.ring[scan.point_index[pixel]];

@@ -17,6 +17,7 @@ inline SensorConfig exactSensor() {
   sensor.name = "exact";
   sensor.beam_elevations_deg = {10.0, 2.0, 0.0, -1.0, -5.0, -12.5, -20.0, -24.9};
   sensor.beam_count = 8;
+  sensor.ring_zero = RingZero::top;  // ring r is the table's beam r (the tests' beam tables count from the top)
   sensor.azimuth_steps = 720;
   sensor.min_range = 0.5;
   sensor.max_range = 120.0;
@@ -45,9 +46,10 @@ inline int stepOf(const Lidar& lidar, const Eigen::Vector3f& point) {
 }
 
 // Elevation (rad) of each beam as the simulator fires it.
+// The beams' elevations indexed by the ring the simulator gives each (sensor.ring_zero).
 inline std::vector<double> elevationsOf(const SensorConfig& sensor) {
   std::vector<double> elevations;
-  for (const float elevation : beamElevations(sensor)) elevations.push_back(elevation);
+  for (const float elevation : ringElevations(sensor)) elevations.push_back(elevation);
   return elevations;
 }
 

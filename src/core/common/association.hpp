@@ -74,6 +74,18 @@ ELO_HOST_DEVICE int nearestModelPixel(const SphericalModel& model, const Float3&
   return detail::nearestModelPixelAround(model, moved, row, col, radius);
 }
 
+// The model pixel of a moved scan point `moved` (normal `normal` before `motion`) that projects to
+// (row, col), when the association and the gates succeed. (The projection is the caller's, so that the
+// CPU can project 8 points at once.)
+template <typename SphericalModel>
+ELO_HOST_DEVICE bool nongroundMatchAtPixel(const SphericalModel& model, const Rigid3f& motion, const Float3& moved,
+                                           const Float3& normal, int row, int col, const CorrespondenceGates& gates,
+                                           int& match) {
+  match = nearestModelPixel(model, moved, row, col, gates.association_radius);
+  if (match < 0 || squaredDistance(model.vertex(match), moved) > gates.max_distance_squared) return false;
+  return !(dot(motion.rotate(normal), model.normal(match)) < gates.min_normal_cosine);
+}
+
 // The non-ground correspondence of scan vertex `vertex` (normal `normal`) under `motion`: the moved point
 // and its model pixel, when the association and the gates succeed.
 template <typename SphericalModel>
@@ -84,9 +96,7 @@ ELO_HOST_DEVICE bool nongroundMatch(const SphericalProjection& projection, const
   int row = 0;
   int col = 0;
   if (!projection.pixelOf(moved, row, col)) return false;
-  match = nearestModelPixel(model, moved, row, col, gates.association_radius);
-  if (match < 0 || squaredDistance(model.vertex(match), moved) > gates.max_distance_squared) return false;
-  return !(dot(motion.rotate(normal), model.normal(match)) < gates.min_normal_cosine);
+  return nongroundMatchAtPixel(model, motion, moved, normal, row, col, gates, match);
 }
 
 namespace detail {

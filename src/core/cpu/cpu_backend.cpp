@@ -21,7 +21,7 @@ CpuBackend::CpuBackend(const Config& config)
       spherical_(SphericalProjection::fromConfig(config.sensor)),
       bev_(BevProjection::fromConfig(config.bev)),
       arena_(arenaThreads(config.runtime.threads)) {
-  for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  for (float elevation : ringElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
   scan_.resize(spherical_.rows, spherical_.cols);
   scan_ground_.resize(bev_.rows, bev_.cols);
   allocate(model_, spherical_, bev_);

@@ -59,7 +59,7 @@ CudaBackend::CudaBackend(const Config& config)
       gates_(CorrespondenceGates::fromConfig(config.registration)),
       pixels_(static_cast<size_t>(spherical_.rows) * spherical_.cols),
       cells_(static_cast<size_t>(bev_.rows) * bev_.cols) {
-  for (float elevation : beamElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
+  for (float elevation : ringElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
   check(cudaGetDevice(&device_), "cudaGetDevice");
   allocate();
   clearDevice();

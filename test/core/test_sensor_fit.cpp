@@ -1,0 +1,109 @@
+// The check that a cloud fits the configured sensor (elo/sensor_fit.hpp), on points placed at known
+// elevations and rings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "elo/sensor_fit.hpp"
+#include "elo/sensor_model.hpp"
+
+namespace elo {
+namespace {
+
+// A point 20 m away at `elevation_deg`, straight ahead.
+Vec3f pointAtElevation(double elevation_deg) {
+  const double elevation = elevation_deg * M_PI / 180.0;
+  return Vec3f(static_cast<float>(20.0 * std::cos(elevation)), 0.0f, static_cast<float>(20.0 * std::sin(elevation)));
+}
+
+// The nominal elevation (deg) of the beam `sensor` numbers `ring`.
+double ringElevationDeg(const SensorConfig& sensor, int ring) { return ringElevations(sensor)[ring] * 180.0 / M_PI; }
+
+PointCloud cloudOf(const std::vector<std::pair<double, uint16_t>>& elevations_and_rings) {
+  PointCloud cloud;
+  for (const auto& [elevation, ring] : elevations_and_rings) {
+    cloud.points.push_back(pointAtElevation(elevation));
+    cloud.ring.push_back(ring);
+  }
+  return cloud;
+}
+
+// The HDL-64E defaults: image from +3 to -25 deg, 64 beams.
+TEST(SensorFit, CountsPointsAboveAndBelowTheImageAndRingsPastTheBeams) {
+  const SensorConfig hdl64;
+  PointCloud cloud = cloudOf({{10.0, 0}, {-30.0, 63}, {-10.0, 70}, {ringElevationDeg(hdl64, 40), 40}, {2.0, 63}});  // ring 63: the top beam, +2 deg
+  cloud.points.push_back(Vec3f(NAN, 0.0f, 0.0f));  // not finite: not sampled
+  cloud.ring.push_back(2);
+  cloud.points.push_back(Vec3f(1.0f, 0.0f, 0.0f));  // closer than sensor.min_range: not sampled
+  cloud.ring.push_back(2);
+  const SensorFit fit = checkSensorFit(cloud, hdl64, 1);
+  EXPECT_EQ(fit.sampled, 5u);
+  EXPECT_EQ(fit.above, 1u);
+  EXPECT_EQ(fit.below, 1u);
+  EXPECT_EQ(fit.unknown_ring, 1u);
+  EXPECT_EQ(fit.off_beam, 0u);
+  const std::string warning = fit.warning(hdl64);
+  EXPECT_NE(warning.find("60% of the scan's points do not fit the sensor model 'hdl64'"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("past its 64 beams"), std::string::npos) << warning;
+}
+
+// Rings numbered the other way (ouster_ros's from the top, where the HDL-64E settings expect
+// velodyne_pointcloud's from the bottom): each point's ring names a beam on the other side of the field
+// of view.
+TEST(SensorFit, CountsPointsFarFromTheirRingsBeam) {
+  const SensorConfig hdl64;
+  ASSERT_EQ(hdl64.ring_zero, RingZero::bottom);
+  std::vector<std::pair<double, uint16_t>> points;
+  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({hdl64.beam_elevations_deg[ring], ring});
+  const SensorFit flipped = checkSensorFit(cloudOf(points), hdl64, 1);
+  EXPECT_EQ(flipped.sampled, 64u);
+  EXPECT_GE(flipped.off_beam, 56u);  // all but the few beams near the table's middle
+  EXPECT_NE(flipped.warning(hdl64).find("over 1.5 deg from their ring's beam"), std::string::npos);
+  SensorConfig top_first = hdl64;
+  top_first.ring_zero = RingZero::top;
+  EXPECT_EQ(checkSensorFit(cloudOf(points), top_first, 1).off_beam, 0u);
+  points.clear();
+  for (uint16_t ring = 0; ring < 64; ++ring) points.push_back({ringElevationDeg(hdl64, ring) - 0.5, ring});
+  EXPECT_EQ(checkSensorFit(cloudOf(points), hdl64, 1).off_beam, 0u);  // half a degree off: calibration
+}
+
+// Close in, where the lasers' offsets on the head bend elevations, a ring is not checked against its beam.
+TEST(SensorFit, LeavesRingsOfClosePointsUnchecked) {
+  PointCloud cloud = cloudOf({{-10.0, 0}});
+  cloud.points[0] *= 0.5f;  // 10 m away
+  EXPECT_EQ(checkSensorFit(cloud, SensorConfig(), 1).off_beam, 0u);
+}
+
+TEST(SensorFit, RingsAreLeftUncheckedWhenTheCloudHasNone) {
+  PointCloud cloud = cloudOf({{-10.0, 70}});
+  cloud.ring.clear();
+  EXPECT_EQ(checkSensorFit(cloud, SensorConfig(), 1).unknown_ring, 0u);
+}
+
+// A few stray points (multipath, a reflection above the horizon) are no reason to warn; a sixth is.
+TEST(SensorFit, WarnsOnlyAboveTheMisplacedShare) {
+  std::vector<std::pair<double, uint16_t>> points(100, {ringElevationDeg(SensorConfig(), 10), 10});
+  for (int i = 0; i < 5; ++i) points[i] = {10.0, 10};
+  const SensorConfig hdl64;
+  EXPECT_EQ(checkSensorFit(cloudOf(points), hdl64, 1).warning(hdl64), "");
+  points[5] = {10.0, 10};
+  EXPECT_NE(checkSensorFit(cloudOf(points), hdl64, 1).warning(hdl64), "");
+}
+
+// The elevation correction is applied before the test, as the projection applies it.
+TEST(SensorFit, TestsElevationsAfterTheCorrection) {
+  SensorConfig sensor;
+  sensor.elevation_correction_deg = 1.0;
+  EXPECT_EQ(checkSensorFit(cloudOf({{2.5, 63}}), sensor, 1).above, 1u);
+  EXPECT_EQ(checkSensorFit(cloudOf({{1.5, 63}}), sensor, 1).above, 0u);
+}
+
+TEST(SensorFit, SamplesEveryStrideThPoint) {
+  const PointCloud cloud = cloudOf({{10.0, 0}, {-10.0, 0}, {10.0, 0}, {-10.0, 0}});
+  const SensorFit fit = checkSensorFit(cloud, SensorConfig(), 2);
+  EXPECT_EQ(fit.sampled, 2u);
+  EXPECT_EQ(fit.above, 2u);
+}
+
+}  // namespace
+}  // namespace elo
