@@ -53,7 +53,9 @@ std::vector<float> beamElevations(const SensorConfig& sensor) {
 }
 
 int ringOfBeam(const SensorConfig& sensor, int beam) {
-  const int beams = static_cast<int>(beamElevations(sensor).size());
+  // Counted without building the table: the simulator asks for every point.
+  const int beams =
+      sensor.beam_elevations_deg.empty() ? sensor.beam_count : static_cast<int>(sensor.beam_elevations_deg.size());
   return sensor.ring_zero == RingZero::top ? beam : beams - 1 - beam;
 }
 
