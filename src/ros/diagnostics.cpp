@@ -24,7 +24,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(failed_registrations, "registrations failed");
   add(restarts, "odometry restarts");
   add(time_warnings, "scans with unusable per-point times");
-  add(sensor_misfits, "scans not fitting the sensor.* settings");
+  add(sensor_misfits, "scans not fitting the sensor model");
   return text.str();
 }
 
