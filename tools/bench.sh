@@ -1,20 +1,24 @@
 #!/usr/bin/env bash
 # Speed figures of the offline runner: per-stage ms as the paper's Table V, FPS, peak memory.
 #  1. The CPU backend's scaling on the 60 real HDL-64E scans, frame-to-model: FPS and each stage's
-#     median at 1, 2 and all threads, and each stage's parallel speed-up over 1 thread. Each setting runs
-#     BENCH_REPEAT times (default 3) and keeps each stage's fastest median, so that other load on the
-#     machine shows less.
+#     median at 1, 2 and all threads (BENCH_THREADS, e.g. "1 2 4 8 all"), and each stage's parallel
+#     speed-up over 1 thread. Each setting runs BENCH_REPEAT times (default 3) and keeps each stage's
+#     fastest median, so that other load on the machine shows less.
 #  2. The CPU backend, frame-to-frame, with 1 and 2 threads, on the same scans.
 #  3. Both backends on the same scans, the real ones and a simulated urban drive, frame-to-model, the CPU
 #     with all its threads. The CUDA runs also print what of the scans' upload to the GPU the frames
 #     waited for (elo_run prefetches each scan while the one before it runs) and the FPS without it. Where the CUDA backend cannot run, they are left out, saying why.
 # Usage:
 #   tools/bench.sh BUILD_DIR SHARED_DATA_DIR
+# BUILD_DIR may also be the directory of the executables themselves (a kit packed by gpu_kit.sh).
+# BENCH_SCANS replaces the real scans of parts 1 and 2 by another sequence (e.g. one elo_sim wrote).
 set -euo pipefail
 build=${1:-build}
 data=${2:-../shared/data}
 bin="$build/devel/lib/elo_odometry"
-scans="$data/real/hdl64_drive_a"
+[ -x "$bin/elo_run" ] || bin=$build
+scans=${BENCH_SCANS:-$data/real/hdl64_drive_a}  # the scaling and f2f runs' scans
+thread_settings=${BENCH_THREADS:-1 2 all}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
@@ -28,7 +32,7 @@ run() {  # elo_run over $1 with the other arguments, printing its summary
 scaling() {
   local repeat=${BENCH_REPEAT:-3} threads run_index
   echo "=== CPU, f2m, scaling over threads, $(basename "$scans") ($(ls "$scans" | wc -l) scans), fastest of $repeat runs"
-  for threads in 1 2 all; do
+  for threads in $thread_settings; do
     for run_index in $(seq "$repeat"); do
       local option=()
       [ "$threads" != all ] && option=(--threads "$threads")
@@ -36,12 +40,11 @@ scaling() {
         --timing "$out/timing_${threads}_${run_index}.csv" >/dev/null
     done
   done
-  python3 - "$out" "$repeat" "$(nproc)" <<'PYTHON'
+  python3 - "$out" "$repeat" "$(nproc)" $thread_settings <<'PYTHON'
 import csv, statistics, sys
-out, repeat, cores = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+out, repeat, cores, settings = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4:]
 stages = [("spherical projection", "projection_ms"), ("feature extraction", "features_ms"),
           ("ICP optimization", "registration_ms"), ("model update", "model_update_ms"), ("total", "total_ms")]
-settings = ["1", "2", "all"]
 def fastest(threads, column):  # each run's median over the processed frames; the fastest run's
     medians = []
     for run in range(1, repeat + 1):
@@ -52,10 +55,14 @@ def fastest(threads, column):  # each run's median over the processed frames; th
         medians.append(statistics.median(values))
     return min(medians)
 table = {s: {t: fastest(t, c) for t in settings} for s, c in stages}
-print(f"{'median ms':<22} {'1 thread':>9} {'2 threads':>10} {'all (' + cores + ')':>9} {'speed-up 2':>11} {'speed-up all':>13}")
+names = {t: f"all ({cores})" if t == "all" else (f"{t} thread" if t == "1" else f"{t} threads") for t in settings}
+others = [t for t in settings if t != settings[0]]
+print(f"{'median ms':<22}" + "".join(f" {names[t]:>10}" for t in settings) +
+      "".join(f" {'speed-up ' + t:>13}" for t in others))
 for name, _ in stages:
     row = table[name]
-    print(f"{name:<22} {row['1']:9.2f} {row['2']:10.2f} {row['all']:9.2f} {row['1'] / row['2']:10.2f}x {row['1'] / row['all']:12.2f}x")
+    print(f"{name:<22}" + "".join(f" {row[t]:10.2f}" for t in settings) +
+          "".join(f" {row[settings[0]] / row[t]:12.2f}x" for t in others))
 def fastest_mean_total(threads):
     means = []
     for run in range(1, repeat + 1):
@@ -63,7 +70,8 @@ def fastest_mean_total(threads):
             means.append(statistics.mean(float(r["total_ms"]) for r in csv.DictReader(f) if r["processed"] == "1"))
     return min(means)
 fps = {t: 1000.0 / fastest_mean_total(t) for t in settings}  # as elo_run's pipeline FPS: 1000 / mean total
-print(f"{'FPS':<22} {fps['1']:9.1f} {fps['2']:10.1f} {fps['all']:9.1f}")
+print(f"{'FPS':<22}" + "".join(f" {fps[t]:10.1f}" for t in settings) +
+      "".join(f" {fps[t] / fps[settings[0]]:12.2f}x" for t in others))
 PYTHON
 }
 

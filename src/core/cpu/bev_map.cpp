@@ -38,57 +38,110 @@ void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pi
 
 namespace {
 
-// How many offers ahead the serial fill asks for a grid cell. The grid (millions of cells) is far larger
-// than the caches and the offers visit it nearly at random, so each lookup would wait for memory; asked
-// this far ahead, the cell is in the cache when its offer comes.
+// How many elements ahead the fill's loops ask for a grid cell. The grid (millions of cells) is far
+// larger than the caches and the offers visit it nearly at random, so each lookup would wait for memory;
+// asked this far ahead, the cell is in the cache when its element comes.
 constexpr size_t kCellPrefetchDistance = 48;
+
+// Runs `body(i)` over [0, count) in parallel, asking `cell_of(i + kCellPrefetchDistance)`'s grid entry
+// ahead (cells < 0 are none).
+template <typename CellOf, typename Body>
+void forEachPrefetchingCells(size_t count, std::vector<int32_t>& grid, const CellOf& cell_of, const Body& body) {
+  parallelForBlocks(count, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (i + kCellPrefetchDistance < end) {
+        const int32_t ahead = cell_of(i + kCellPrefetchDistance);
+        if (ahead >= 0) __builtin_prefetch(&grid[ahead], 1);
+      }
+      body(i);
+    }
+  });
+}
+
+// BevImage::clear() across the threads: each point's cell is emptied, so the cost is the point count.
+void takeOffGrid(BevImage& map) {
+  forEachPrefetchingCells(
+      map.cell.size(), map.point_of_cell, [&](size_t point) { return map.cell[point]; },
+      [&](size_t point) { map.point_of_cell[map.cell[point]] = -1; });
+  map.cell.clear();
+  map.vertex.clear();
+  map.range.clear();
+  map.stamp.clear();
+}
+
+// The grid entry as unsigned, so that "empty" (-1) is the largest value and the smallest offer index kept
+// in it is the cell's first offer. Signed and unsigned views of one integer may alias.
+uint32_t& asUnsigned(int32_t& entry) { return reinterpret_cast<uint32_t&>(entry); }
 
 }  // namespace
 
+// Every round runs over the offers in parallel; a cell's or slot's winner is a minimum (keepSmaller()),
+// which does not depend on the order the threads offer in, so the map is the same for any thread count
+// and element by element the same as the CUDA backend's (bev_map.cu). The grid is read twice per offer,
+// to find each cell's first offer; the rounds then work on per-offer and per-slot arrays, which the
+// caches hold.
 void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
   const std::vector<GroundOffer>& offers = scratch.offers;
-  map.clear();
-  // Round 1: the closest offer's range per cell. A cell takes the next slot at its first offer.
+  const auto cell_of_offer = [&](size_t i) { return offers[i].cell; };
+  const bool alone = runsAlone();
+  takeOffGrid(map);
+  // Each cell's first offer: the smallest offer index, kept in the emptied grid, then read back per offer.
+  forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
+    if (offers[i].cell >= 0) keepSmaller(asUnsigned(map.point_of_cell[offers[i].cell]), static_cast<uint32_t>(i), alone);
+  });
+  std::vector<int32_t>& first_of_offer = scratch.first_of_offer;
+  first_of_offer.resize(offers.size());
+  forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
+    first_of_offer[i] = offers[i].cell >= 0 ? map.point_of_cell[offers[i].cell] : -1;
+  });
+  // A cell's slot is the number of first offers before its own.
+  std::vector<int32_t>& first_offers = scratch.first_offers;
+  parallelSelect(offers.size(), [&](size_t i) { return first_of_offer[i] == static_cast<int32_t>(i); }, first_offers);
+  const size_t slots = first_offers.size();
   std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
-  slot_of_offer.resize(offers.size());
-  for (size_t i = 0; i < offers.size(); ++i) {
-    if (i + kCellPrefetchDistance < offers.size()) {
-      const int32_t ahead = offers[i + kCellPrefetchDistance].cell;
-      if (ahead >= 0) __builtin_prefetch(&map.point_of_cell[ahead], 1);
-    }
-    const GroundOffer& offer = offers[i];
-    if (offer.cell < 0) continue;
-    int32_t& slot = map.point_of_cell[offer.cell];
-    if (slot < 0) {
-      slot = static_cast<int32_t>(map.cell.size());
-      map.cell.push_back(offer.cell);
-      map.range.push_back(offer.range);
-    } else if (offer.range < map.range[slot]) {
-      map.range[slot] = offer.range;
-    }
-    slot_of_offer[i] = slot;
-  }
-  // Round 2: the oldest offer on that surface.
-  const size_t slots = map.cell.size();
+  std::vector<ClosestKey>& closest = scratch.closest;
   std::vector<ClosestKey>& oldest = scratch.oldest;
-  std::vector<int32_t>& winner = scratch.winner;
-  oldest.assign(slots, kNoClosestKey);
-  winner.resize(slots);
-  for (size_t i = 0; i < offers.size(); ++i) {
-    const GroundOffer& offer = offers[i];
-    if (offer.cell < 0) continue;
-    const int32_t slot = slot_of_offer[i];
-    if (!onClosestSurface(offer.range, map.range[slot], same_surface_distance)) continue;
-    const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
-    if (key < oldest[slot]) {
-      oldest[slot] = key;
-      winner[slot] = static_cast<int32_t>(i);
-    }
-  }
+  slot_of_offer.resize(offers.size());
+  closest.resize(slots);
+  oldest.resize(slots);
+  map.cell.resize(slots);
   map.vertex.resize(slots);
+  map.range.resize(slots);
   map.stamp.resize(slots);
-  parallelFor(slots, [&](size_t slot) {
-    const GroundOffer& offer = offers[winner[slot]];
+  forEachPrefetchingCells(
+      slots, map.point_of_cell, [&](size_t slot) { return offers[first_offers[slot]].cell; },
+      [&](size_t slot) {
+        const int32_t first = first_offers[slot];
+        const int32_t cell = offers[first].cell;
+        map.cell[slot] = cell;
+        map.point_of_cell[cell] = static_cast<int32_t>(slot);
+        slot_of_offer[first] = static_cast<int32_t>(slot);
+        closest[slot] = kNoClosestKey;
+        oldest[slot] = kNoClosestKey;
+      });
+  // Round 1: the closest offer per slot. An offer's slot is its cell's first offer's; those were all
+  // written above, and this round writes only the others'.
+  parallelFor(offers.size(), [&](size_t i) {
+    const int32_t first = first_of_offer[i];
+    if (first < 0) return;
+    if (first != static_cast<int32_t>(i)) slot_of_offer[i] = slot_of_offer[first];
+    keepSmaller(closest[slot_of_offer[i]], closestWinsKey(offers[i].range, offers[i].source), alone);
+  });
+  // Round 2: the oldest offer on that surface.
+  parallelFor(offers.size(), [&](size_t i) {
+    const GroundOffer& offer = offers[i];
+    if (offer.cell < 0) return;
+    const int32_t slot = slot_of_offer[i];
+    if (onClosestSurface(offer.range, closestWinsRange(closest[slot]), same_surface_distance)) {
+      keepSmaller(oldest[slot], oldestWinsKey(offer.stamp, offer.source), alone);
+    }
+  });
+  // The offer whose key its slot kept (sources are unique) writes the slot.
+  parallelFor(offers.size(), [&](size_t i) {
+    const GroundOffer& offer = offers[i];
+    if (offer.cell < 0) return;
+    const int32_t slot = slot_of_offer[i];
+    if (oldest[slot] != oldestWinsKey(offer.stamp, offer.source)) return;
     map.vertex[slot] = offer.vertex;
     map.range[slot] = offer.range;
     map.stamp[slot] = offer.stamp;

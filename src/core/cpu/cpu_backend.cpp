@@ -69,7 +69,7 @@ void CpuBackend::estimateNormals() {
 void CpuBackend::buildGroundMap() {
   arena_.execute([&] {
     cpu::buildGroundMap(scan_, ground_pixels_, bev_, static_cast<float>(config_.model.same_surface_distance),
-                        ground_scratch_, scan_ground_);
+                        scan_ground_scratch_, scan_ground_);
   });
 }
 
@@ -98,7 +98,7 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
   arena_.execute([&] {
     fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, fusion_scratch_, fused_.nonground);
-    fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, ground_scratch_, fused_.ground);
+    fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_ground_scratch_, fused_.ground);
   });
   std::swap(model_, fused_);
   model_.initialized = true;

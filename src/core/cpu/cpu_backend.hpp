@@ -38,7 +38,10 @@ class CpuBackend final : public Backend {
   SweepVelocity scan_velocity_{};
   std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
   std::vector<int32_t> ground_pixels_;  // as labelled; the ground map is built (and rebuilt) from them
-  GroundMapScratch ground_scratch_;  // the scan's and the model's ground maps' scratch
+  // Each ground map its own scratch: its arrays then keep about their size from frame to frame, and a
+  // resize seldom has new elements to initialise.
+  GroundMapScratch scan_ground_scratch_;
+  GroundMapScratch fused_ground_scratch_;
   BevImage scan_ground_;
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_

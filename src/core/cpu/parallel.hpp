@@ -116,18 +116,27 @@ void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& select
 // Whether the loops of the current arena run on one thread only (a backend with `runtime.threads` 1).
 inline bool runsAlone() { return tbb::this_task_arena::max_concurrency() == 1; }
 
-// Runs `body(i)` for every i in [0, count) across the threads of the current arena.
+// Runs `body(begin, end)` over blocks that split [0, count) across the threads of the current arena, for
+// loops that look ahead within their block (prefetches).
 template <typename Body>
-void parallelFor(size_t count, const Body& body) {
+void parallelForBlocks(size_t count, const Body& body) {
   ForkJoinOrder order;
   const auto run_range = [&](const tbb::blocked_range<size_t>& range) {
     ForkJoinOrder::taskStarts();
-    for (size_t i = range.begin(); i != range.end(); ++i) body(i);
+    body(range.begin(), range.end());
     order.taskEnds();
   };
   order.beforeLoop(run_range);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1024), run_range);
   order.afterLoop();
+}
+
+// Runs `body(i)` for every i in [0, count) across the threads of the current arena.
+template <typename Body>
+void parallelFor(size_t count, const Body& body) {
+  parallelForBlocks(count, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i != end; ++i) body(i);
+  });
 }
 
 }  // namespace elo::cpu

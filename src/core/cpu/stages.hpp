@@ -73,10 +73,12 @@ struct GroundOffer {
 // The offers a ground map is filled with (fillGroundMap()) and the fill's own arrays, kept by the
 // backend so that no frame allocates them again (each fresh allocation costs page faults and zeroing).
 struct GroundMapScratch {
-  std::vector<GroundOffer> offers;     // in the order of their sources
-  std::vector<int32_t> slot_of_offer;  // round 1: the slot of each offer's cell
-  std::vector<ClosestKey> oldest;      // round 2, per slot: the oldest offer's key
-  std::vector<int32_t> winner;         // round 2, per slot: that offer
+  std::vector<GroundOffer> offers;      // in the order of their sources
+  std::vector<int32_t> first_of_offer;  // per offer: the first offer to its cell (-1: no cell)
+  std::vector<int32_t> first_offers;    // per slot: the first offer to its cell
+  std::vector<int32_t> slot_of_offer;   // per offer: its cell's slot
+  std::vector<ClosestKey> closest;      // round 1, per slot: the closest offer's key
+  std::vector<ClosestKey> oldest;       // round 2, per slot: the oldest offer's key on that surface
 };
 
 // bev_map.cpp: the pixels labelled ground, in increasing order.
