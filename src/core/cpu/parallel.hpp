@@ -56,12 +56,17 @@ class ForkJoinOrder {
 #endif
 };
 
+// The fixed blocks of deterministicSum() and parallelSelect(): small enough that the 10,000 to 100,000
+// elements of a scan's loops give every thread of a 16-core machine several blocks, large enough that a
+// block's fork costs little against its work.
+constexpr size_t kFixedBlock = 1024;
+
 // Sums `body(begin, end, partial)` over [0, count) in fixed blocks and adds the block results in block
 // order. The result is therefore the same bit for bit whatever the number of threads, so trajectories
 // are reproducible across machines, thread counts and runs.
 template <typename Sum, typename Body>
 Sum deterministicSum(size_t count, const Body& body) {
-  constexpr size_t kBlock = 4096;
+  constexpr size_t kBlock = kFixedBlock;
   const size_t blocks = (count + kBlock - 1) / kBlock;
   std::vector<Sum> partials(blocks);
   ForkJoinOrder order;
@@ -83,7 +88,7 @@ Sum deterministicSum(size_t count, const Body& body) {
 // writes its own, so the list is found in parallel and comes out the same whatever the thread count.
 template <typename Keep>
 void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& selected) {
-  constexpr size_t kBlock = 4096;
+  constexpr size_t kBlock = kFixedBlock;
   const size_t blocks = (count + kBlock - 1) / kBlock;
   std::vector<size_t> first(blocks + 1, 0);  // first[b + 1]: block b's count, then where it starts
   ForkJoinOrder counting;
@@ -117,7 +122,9 @@ void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& select
 inline bool runsAlone() { return tbb::this_task_arena::max_concurrency() == 1; }
 
 // Runs `body(begin, end)` over blocks that split [0, count) across the threads of the current arena, for
-// loops that look ahead within their block (prefetches).
+// loops that look ahead within their block (prefetches). TBB sizes the blocks from the thread count and
+// splits them further as threads fall idle; no minimum size is set, so that a loop over few heavy items
+// (image rows or columns, blocks of pixels) spreads over every thread too.
 template <typename Body>
 void parallelForBlocks(size_t count, const Body& body) {
   ForkJoinOrder order;
@@ -127,7 +134,7 @@ void parallelForBlocks(size_t count, const Body& body) {
     order.taskEnds();
   };
   order.beforeLoop(run_range);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1024), run_range);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count), run_range);
   order.afterLoop();
 }
 
