@@ -1,7 +1,9 @@
 // The model update of Sec. III-D: the closer surface wins and keeps its oldest point, empty pixels keep the
 // model, old points expire.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 
@@ -229,6 +231,64 @@ TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
   EXPECT_EQ(map.vertex[2], a_old) << "one surface seen again keeps its oldest point";
   EXPECT_EQ(map.stamp, (std::vector<float>{2.0f, 2.0f, 1.0f}));
   for (int32_t slot = 0; slot < 3; ++slot) EXPECT_FLOAT_EQ(map.range[slot], map.vertex[slot].norm());
+}
+
+// Many offers crowding a few hundred cells, some offered to no cell: on one thread the fill takes each
+// offer in turn, on several it finds first offers and winners by minima (bev_map.cpp). Both must give the
+// map the rules give, computed here cell by cell: slots in the order of each cell's first offer, each
+// keeping the oldest offer (lowest source among equals) within the surface distance of the closest.
+TEST(ModelUpdate, GroundMapIsTheRulesMapOnOneThreadAndOnMany) {
+  Fixture f;
+  constexpr float kSameSurface = 0.3f;
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int32_t> cell_index(-40, 399);  // negative: offered to no cell
+  std::uniform_real_distribution<float> height(-2.0f, -1.2f);
+  std::uniform_int_distribution<int> age(0, 3);
+  std::vector<cpu::GroundOffer>& offers = f.ground_scratch.offers;
+  std::vector<uint32_t> sources(60000);
+  for (uint32_t i = 0; i < sources.size(); ++i) sources[i] = 3 * i + 1;
+  std::shuffle(sources.begin(), sources.end(), random);  // lower sources come later as often as earlier
+  for (const uint32_t source : sources) {
+    const int32_t index = cell_index(random);
+    const int32_t cell = index < 0 ? -1 : 5000 + 37 * index;
+    const Vec3f point(10.0f + 0.001f * static_cast<float>(index), 2.0f, height(random));
+    offers.emplace_back(cell, point, static_cast<float>(age(random)), source);
+  }
+  // The rules, cell by cell.
+  std::vector<int32_t> expected_cells;
+  std::map<int32_t, float> closest;
+  std::map<int32_t, const cpu::GroundOffer*> kept;
+  for (const cpu::GroundOffer& offer : offers) {
+    if (offer.cell < 0) continue;
+    if (closest.count(offer.cell) == 0) expected_cells.push_back(offer.cell);
+    closest[offer.cell] = closest.count(offer.cell) ? std::min(closest[offer.cell], offer.range) : offer.range;
+  }
+  for (const cpu::GroundOffer& offer : offers) {
+    if (offer.cell < 0 || offer.range > closest[offer.cell] + kSameSurface) continue;
+    const cpu::GroundOffer*& best = kept[offer.cell];
+    if (best == nullptr || offer.stamp < best->stamp || (offer.stamp == best->stamp && offer.source < best->source)) {
+      best = &offer;
+    }
+  }
+  ASSERT_GT(expected_cells.size(), 400u - 5u);
+
+  for (const int threads : {1, 2}) {
+    BevImage map = f.emptyBevMap();
+    tbb::task_arena(threads).execute([&] {
+      cpu::fillGroundMap(kSameSurface, f.ground_scratch, map);
+      cpu::fillGroundMap(kSameSurface, f.ground_scratch, map);  // a full map is emptied first
+    });
+    ASSERT_EQ(map.cell, expected_cells) << threads << " threads";
+    for (size_t slot = 0; slot < map.size(); ++slot) {
+      const cpu::GroundOffer& best = *kept[map.cell[slot]];
+      EXPECT_EQ(map.point_of_cell[map.cell[slot]], static_cast<int32_t>(slot));
+      EXPECT_EQ(map.vertex[slot], best.vertex) << threads << " threads, slot " << slot;
+      EXPECT_EQ(map.stamp[slot], best.stamp);
+      EXPECT_EQ(map.range[slot], best.range);
+    }
+    EXPECT_EQ(std::count_if(map.point_of_cell.begin(), map.point_of_cell.end(), [](int32_t p) { return p >= 0; }),
+              static_cast<std::ptrdiff_t>(map.size()));
+  }
 }
 
 // The fused map lists the model's surviving points in their order, then the scan's new cells.

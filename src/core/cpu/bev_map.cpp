@@ -43,19 +43,23 @@ namespace {
 // asked this far ahead, the cell is in the cache when its element comes.
 constexpr size_t kCellPrefetchDistance = 48;
 
-// Runs `body(i)` over [0, count) in parallel, asking `cell_of(i + kCellPrefetchDistance)`'s grid entry
+// Runs `body(i)` for i in [begin, end) in order, asking `cell_of(i + kCellPrefetchDistance)`'s grid entry
 // ahead (cells < 0 are none).
 template <typename CellOf, typename Body>
-void forEachPrefetchingCells(size_t count, std::vector<int32_t>& grid, const CellOf& cell_of, const Body& body) {
-  parallelForBlocks(count, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      if (i + kCellPrefetchDistance < end) {
-        const int32_t ahead = cell_of(i + kCellPrefetchDistance);
-        if (ahead >= 0) __builtin_prefetch(&grid[ahead], 1);
-      }
-      body(i);
+void prefetchingCells(size_t begin, size_t end, std::vector<int32_t>& grid, const CellOf& cell_of, const Body& body) {
+  for (size_t i = begin; i < end; ++i) {
+    if (i + kCellPrefetchDistance < end) {
+      const int32_t ahead = cell_of(i + kCellPrefetchDistance);
+      if (ahead >= 0) __builtin_prefetch(&grid[ahead], 1);
     }
-  });
+    body(i);
+  }
+}
+
+// The same over [0, count), in parallel.
+template <typename CellOf, typename Body>
+void forEachPrefetchingCells(size_t count, std::vector<int32_t>& grid, const CellOf& cell_of, const Body& body) {
+  parallelForBlocks(count, [&](size_t begin, size_t end) { prefetchingCells(begin, end, grid, cell_of, body); });
 }
 
 // BevImage::clear() across the threads: each point's cell is emptied, so the cost is the point count.
@@ -73,41 +77,61 @@ void takeOffGrid(BevImage& map) {
 // in it is the cell's first offer. Signed and unsigned views of one integer may alias.
 uint32_t& asUnsigned(int32_t& entry) { return reinterpret_cast<uint32_t&>(entry); }
 
-}  // namespace
+// Sizes the per-slot arrays of the map and the rounds once the slot count is known.
+void sizeSlots(size_t slots, GroundMapScratch& scratch, BevImage& map) {
+  scratch.closest.resize(slots);
+  scratch.oldest.assign(slots, kNoClosestKey);
+  map.cell.resize(slots);
+  map.vertex.resize(slots);
+  map.range.resize(slots);
+  map.stamp.resize(slots);
+}
 
-// Every round runs over the offers in parallel; a cell's or slot's winner is a minimum (keepSmaller()),
-// which does not depend on the order the threads offer in, so the map is the same for any thread count
-// and element by element the same as the CUDA backend's (bev_map.cu). The grid is read twice per offer,
-// to find each cell's first offer; the rounds then work on per-offer and per-slot arrays, which the
-// caches hold.
-void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
-  const std::vector<GroundOffer>& offers = scratch.offers;
+// The slots and round 1 on one thread, in one sweep over the offers: a cell takes the next slot at its
+// first offer. The grid is visited once per offer.
+void slotsAndClosestAlone(const std::vector<GroundOffer>& offers, GroundMapScratch& scratch, BevImage& map) {
+  std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
+  std::vector<ClosestKey>& closest = scratch.closest;
+  slot_of_offer.resize(offers.size());
+  closest.clear();
+  prefetchingCells(
+      0, offers.size(), map.point_of_cell, [&](size_t i) { return offers[i].cell; },
+      [&](size_t i) {
+        const GroundOffer& offer = offers[i];
+        if (offer.cell < 0) return;
+        int32_t& slot = map.point_of_cell[offer.cell];
+        if (slot < 0) {
+          slot = static_cast<int32_t>(map.cell.size());
+          map.cell.push_back(offer.cell);
+          closest.push_back(kNoClosestKey);
+        }
+        slot_of_offer[i] = slot;
+        keepSmaller(closest[slot], closestWinsKey(offer.range, offer.source), true);
+      });
+  sizeSlots(map.cell.size(), scratch, map);
+}
+
+// The same across threads. Each cell's first offer is the smallest offer index, kept by a minimum in the
+// emptied grid and read back per offer; a cell's slot is the number of first offers before its own. The
+// grid is visited twice per offer; round 1 then works on per-offer and per-slot arrays, which the caches
+// hold.
+void slotsAndClosestInParallel(const std::vector<GroundOffer>& offers, GroundMapScratch& scratch, BevImage& map) {
   const auto cell_of_offer = [&](size_t i) { return offers[i].cell; };
-  const bool alone = runsAlone();
-  takeOffGrid(map);
-  // Each cell's first offer: the smallest offer index, kept in the emptied grid, then read back per offer.
   forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
-    if (offers[i].cell >= 0) keepSmaller(asUnsigned(map.point_of_cell[offers[i].cell]), static_cast<uint32_t>(i), alone);
+    if (offers[i].cell >= 0) keepSmaller(asUnsigned(map.point_of_cell[offers[i].cell]), static_cast<uint32_t>(i), false);
   });
   std::vector<int32_t>& first_of_offer = scratch.first_of_offer;
   first_of_offer.resize(offers.size());
   forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
     first_of_offer[i] = offers[i].cell >= 0 ? map.point_of_cell[offers[i].cell] : -1;
   });
-  // A cell's slot is the number of first offers before its own.
   std::vector<int32_t>& first_offers = scratch.first_offers;
   parallelSelect(offers.size(), [&](size_t i) { return first_of_offer[i] == static_cast<int32_t>(i); }, first_offers);
   const size_t slots = first_offers.size();
+  sizeSlots(slots, scratch, map);
   std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
   std::vector<ClosestKey>& closest = scratch.closest;
-  std::vector<ClosestKey>& oldest = scratch.oldest;
   slot_of_offer.resize(offers.size());
-  closest.resize(slots);
-  oldest.resize(slots);
-  map.cell.resize(slots);
-  map.vertex.resize(slots);
-  map.range.resize(slots);
-  map.stamp.resize(slots);
   forEachPrefetchingCells(
       slots, map.point_of_cell, [&](size_t slot) { return offers[first_offers[slot]].cell; },
       [&](size_t slot) {
@@ -117,17 +141,36 @@ void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevIm
         map.point_of_cell[cell] = static_cast<int32_t>(slot);
         slot_of_offer[first] = static_cast<int32_t>(slot);
         closest[slot] = kNoClosestKey;
-        oldest[slot] = kNoClosestKey;
       });
-  // Round 1: the closest offer per slot. An offer's slot is its cell's first offer's; those were all
-  // written above, and this round writes only the others'.
+  // An offer's slot is its cell's first offer's: those were all written above, and this loop writes only
+  // the others'.
   parallelFor(offers.size(), [&](size_t i) {
     const int32_t first = first_of_offer[i];
     if (first < 0) return;
     if (first != static_cast<int32_t>(i)) slot_of_offer[i] = slot_of_offer[first];
-    keepSmaller(closest[slot_of_offer[i]], closestWinsKey(offers[i].range, offers[i].source), alone);
+    keepSmaller(closest[slot_of_offer[i]], closestWinsKey(offers[i].range, offers[i].source), false);
   });
+}
+
+}  // namespace
+
+// A cell's or slot's winner is a minimum (keepSmaller()), which does not depend on the order the threads
+// offer in, so the map is the same for any thread count and element by element the same as the CUDA
+// backend's (bev_map.cu).
+void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
+  const std::vector<GroundOffer>& offers = scratch.offers;
+  const bool alone = runsAlone();
+  takeOffGrid(map);
+  // Round 1: the slots, and the closest offer per slot.
+  if (alone) {
+    slotsAndClosestAlone(offers, scratch, map);
+  } else {
+    slotsAndClosestInParallel(offers, scratch, map);
+  }
   // Round 2: the oldest offer on that surface.
+  const std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
+  const std::vector<ClosestKey>& closest = scratch.closest;
+  std::vector<ClosestKey>& oldest = scratch.oldest;
   parallelFor(offers.size(), [&](size_t i) {
     const GroundOffer& offer = offers[i];
     if (offer.cell < 0) return;
