@@ -73,27 +73,93 @@ void takeOffGrid(BevImage& map) {
   map.stamp.clear();
 }
 
-// The grid entry as unsigned, so that "empty" (-1) is the largest value and the smallest offer index kept
-// in it is the cell's first offer. Signed and unsigned views of one integer may alias.
-uint32_t& asUnsigned(int32_t& entry) { return reinterpret_cast<uint32_t&>(entry); }
+// Offers are grouped by bands of 2^kBandShift consecutive grid cells (about 3.4 rows of the default
+// grid): a band's cells are filled by one thread, so no two threads ever offer to one cell. Bands this
+// narrow split a map's offers into enough groups for any thread count; a shift finds an offer's band
+// without a division.
+constexpr int kBandShift = 13;
 
-// Sizes the per-slot arrays of the map and the rounds once the slot count is known.
-void sizeSlots(size_t slots, GroundMapScratch& scratch, BevImage& map) {
-  scratch.closest.resize(slots);
-  scratch.oldest.assign(slots, kNoClosestKey);
-  map.cell.resize(slots);
-  map.vertex.resize(slots);
-  map.range.resize(slots);
-  map.stamp.resize(slots);
+// Copies the offers, grouped by band, into scratch.banded (band b's from band_start[b] to band_start[b + 1],
+// each band's in the offers' order, with their indices in banded_index), leaving out those offered to no
+// cell. A counting sort over fixed blocks of offers: each block counts its offers per band, the counts
+// place every (band, block) run one after another, and each block writes its own runs, so the result is
+// the same whatever the thread count.
+void groupByBand(const std::vector<GroundOffer>& offers, size_t bands, GroundMapScratch& scratch) {
+  const size_t blocks = (offers.size() + kFixedBlock - 1) / kFixedBlock;
+  const auto band_of = [](int32_t cell) { return static_cast<size_t>(cell) >> kBandShift; };
+  std::vector<int32_t>& place = scratch.band_place;  // [block * bands + band]: a count, then where the run starts
+  place.assign(blocks * bands, 0);
+  parallelFor(blocks, [&](size_t block) {
+    for (size_t i = block * kFixedBlock; i < std::min(offers.size(), (block + 1) * kFixedBlock); ++i) {
+      if (offers[i].cell >= 0) ++place[block * bands + band_of(offers[i].cell)];
+    }
+  });
+  std::vector<int32_t>& band_start = scratch.band_start;
+  band_start.assign(bands + 1, 0);
+  parallelFor(bands, [&](size_t band) {
+    for (size_t block = 0; block < blocks; ++block) band_start[band + 1] += place[block * bands + band];
+  });
+  for (size_t band = 0; band < bands; ++band) band_start[band + 1] += band_start[band];
+  parallelFor(bands, [&](size_t band) {
+    int32_t at = band_start[band];
+    for (size_t block = 0; block < blocks; ++block) {
+      const int32_t count = place[block * bands + band];
+      place[block * bands + band] = at;
+      at += count;
+    }
+  });
+  const size_t grouped = static_cast<size_t>(band_start[bands]);
+  scratch.banded.resize(grouped);
+  scratch.banded_index.resize(grouped);
+  parallelFor(blocks, [&](size_t block) {
+    for (size_t i = block * kFixedBlock; i < std::min(offers.size(), (block + 1) * kFixedBlock); ++i) {
+      if (offers[i].cell < 0) continue;
+      const int32_t at = place[block * bands + band_of(offers[i].cell)]++;
+      scratch.banded[at] = offers[i];
+      scratch.banded_index[at] = static_cast<int32_t>(i);
+    }
+  });
 }
 
-// The slots and round 1 on one thread, in one sweep over the offers: a cell takes the next slot at its
-// first offer. The grid is visited once per offer.
-void slotsAndClosestAlone(const std::vector<GroundOffer>& offers, GroundMapScratch& scratch, BevImage& map) {
-  std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
-  std::vector<ClosestKey>& closest = scratch.closest;
+// Both rounds for the cells of one band: its grouped offers [begin, end), in their order. A cell's state
+// lives at its first offer's position: the grid holds that position meanwhile, `closest` and `oldest` the
+// rounds' keys there, `winner` the position of the offer with the oldest key.
+void fillBand(size_t begin, size_t end, float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
+  const std::vector<GroundOffer>& banded = scratch.banded;
+  for (size_t at = begin; at < end; ++at) {
+    if (at + kCellPrefetchDistance < end) __builtin_prefetch(&map.point_of_cell[banded[at + kCellPrefetchDistance].cell], 1);
+    const GroundOffer& offer = banded[at];
+    int32_t& first = map.point_of_cell[offer.cell];
+    const ClosestKey key = closestWinsKey(offer.range, offer.source);
+    if (first < 0) {
+      first = static_cast<int32_t>(at);
+      scratch.closest[at] = key;
+      scratch.oldest[at] = kNoClosestKey;
+      scratch.first_position[scratch.banded_index[at]] = first;
+    } else if (key < scratch.closest[first]) {
+      scratch.closest[first] = key;
+    }
+    scratch.first_of[at] = first;
+  }
+  for (size_t at = begin; at < end; ++at) {
+    const GroundOffer& offer = banded[at];
+    const int32_t first = scratch.first_of[at];
+    if (!onClosestSurface(offer.range, closestWinsRange(scratch.closest[first]), same_surface_distance)) continue;
+    const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
+    if (key < scratch.oldest[first]) {
+      scratch.oldest[first] = key;
+      scratch.winner[first] = static_cast<int32_t>(at);
+    }
+  }
+}
+
+// The map on one thread, taking every offer in turn; a cell takes the next slot at its first offer. Here
+// `first_of` holds each offer's slot, `oldest` and `winner` are per slot, and the map's ranges hold round
+// 1's closest range.
+void fillInTurn(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
+  const std::vector<GroundOffer>& offers = scratch.offers;
+  std::vector<int32_t>& slot_of_offer = scratch.first_of;
   slot_of_offer.resize(offers.size());
-  closest.clear();
   prefetchingCells(
       0, offers.size(), map.point_of_cell, [&](size_t i) { return offers[i].cell; },
       [&](size_t i) {
@@ -103,92 +169,87 @@ void slotsAndClosestAlone(const std::vector<GroundOffer>& offers, GroundMapScrat
         if (slot < 0) {
           slot = static_cast<int32_t>(map.cell.size());
           map.cell.push_back(offer.cell);
-          closest.push_back(kNoClosestKey);
+          map.range.push_back(offer.range);
+        } else if (offer.range < map.range[slot]) {
+          map.range[slot] = offer.range;
         }
         slot_of_offer[i] = slot;
-        keepSmaller(closest[slot], closestWinsKey(offer.range, offer.source), true);
       });
-  sizeSlots(map.cell.size(), scratch, map);
+  const size_t slots = map.cell.size();
+  std::vector<ClosestKey>& oldest = scratch.oldest;
+  std::vector<int32_t>& winner = scratch.winner;
+  oldest.assign(slots, kNoClosestKey);
+  winner.resize(slots);
+  for (size_t i = 0; i < offers.size(); ++i) {
+    const GroundOffer& offer = offers[i];
+    if (offer.cell < 0) continue;
+    const int32_t slot = slot_of_offer[i];
+    if (!onClosestSurface(offer.range, map.range[slot], same_surface_distance)) continue;
+    const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
+    if (key < oldest[slot]) {
+      oldest[slot] = key;
+      winner[slot] = static_cast<int32_t>(i);
+    }
+  }
+  map.vertex.resize(slots);
+  map.stamp.resize(slots);
+  for (size_t slot = 0; slot < slots; ++slot) {
+    const GroundOffer& kept = offers[winner[slot]];
+    map.vertex[slot] = kept.vertex;
+    map.range[slot] = kept.range;
+    map.stamp[slot] = kept.stamp;
+  }
 }
 
-// The same across threads. Each cell's first offer is the smallest offer index, kept by a minimum in the
-// emptied grid and read back per offer; a cell's slot is the number of first offers before its own. The
-// grid is visited twice per offer; round 1 then works on per-offer and per-slot arrays, which the caches
-// hold.
-void slotsAndClosestInParallel(const std::vector<GroundOffer>& offers, GroundMapScratch& scratch, BevImage& map) {
-  const auto cell_of_offer = [&](size_t i) { return offers[i].cell; };
-  forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
-    if (offers[i].cell >= 0) keepSmaller(asUnsigned(map.point_of_cell[offers[i].cell]), static_cast<uint32_t>(i), false);
-  });
-  std::vector<int32_t>& first_of_offer = scratch.first_of_offer;
-  first_of_offer.resize(offers.size());
-  forEachPrefetchingCells(offers.size(), map.point_of_cell, cell_of_offer, [&](size_t i) {
-    first_of_offer[i] = offers[i].cell >= 0 ? map.point_of_cell[offers[i].cell] : -1;
+// The map across threads: the offers grouped by band, each band's cells filled by one thread in the
+// offers' order, which is what fillInTurn() does for them; the slots then follow the first offers in
+// their order. No atomics are needed, and the map is fillInTurn()'s.
+void fillByBands(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
+  const std::vector<GroundOffer>& offers = scratch.offers;
+  const size_t bands = (map.cellCount() >> kBandShift) + 1;
+  groupByBand(offers, bands, scratch);
+  const size_t grouped = scratch.banded.size();
+  scratch.first_position.assign(offers.size(), -1);
+  scratch.first_of.resize(grouped);
+  scratch.closest.resize(grouped);
+  scratch.oldest.resize(grouped);
+  scratch.winner.resize(grouped);
+  parallelFor(bands, [&](size_t band) {
+    fillBand(scratch.band_start[band], scratch.band_start[band + 1], same_surface_distance, scratch, map);
   });
   std::vector<int32_t>& first_offers = scratch.first_offers;
-  parallelSelect(offers.size(), [&](size_t i) { return first_of_offer[i] == static_cast<int32_t>(i); }, first_offers);
+  parallelSelect(offers.size(), [&](size_t i) { return scratch.first_position[i] >= 0; }, first_offers);
   const size_t slots = first_offers.size();
-  sizeSlots(slots, scratch, map);
-  std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
-  std::vector<ClosestKey>& closest = scratch.closest;
-  slot_of_offer.resize(offers.size());
+  map.cell.resize(slots);
+  map.vertex.resize(slots);
+  map.range.resize(slots);
+  map.stamp.resize(slots);
   forEachPrefetchingCells(
       slots, map.point_of_cell, [&](size_t slot) { return offers[first_offers[slot]].cell; },
       [&](size_t slot) {
-        const int32_t first = first_offers[slot];
-        const int32_t cell = offers[first].cell;
+        const int32_t first = scratch.first_position[first_offers[slot]];
+        const GroundOffer& kept = scratch.banded[scratch.winner[first]];
+        const int32_t cell = scratch.banded[first].cell;
         map.cell[slot] = cell;
         map.point_of_cell[cell] = static_cast<int32_t>(slot);
-        slot_of_offer[first] = static_cast<int32_t>(slot);
-        closest[slot] = kNoClosestKey;
+        map.vertex[slot] = kept.vertex;
+        map.range[slot] = kept.range;
+        map.stamp[slot] = kept.stamp;
       });
-  // An offer's slot is its cell's first offer's: those were all written above, and this loop writes only
-  // the others'.
-  parallelFor(offers.size(), [&](size_t i) {
-    const int32_t first = first_of_offer[i];
-    if (first < 0) return;
-    if (first != static_cast<int32_t>(i)) slot_of_offer[i] = slot_of_offer[first];
-    keepSmaller(closest[slot_of_offer[i]], closestWinsKey(offers[i].range, offers[i].source), false);
-  });
 }
 
 }  // namespace
 
-// A cell's or slot's winner is a minimum (keepSmaller()), which does not depend on the order the threads
-// offer in, so the map is the same for any thread count and element by element the same as the CUDA
-// backend's (bev_map.cu).
+// Grouping the offers costs about as much as filling the map, so it pays only where more than two threads
+// share it. Both ways give the same map, element by element the same as the CUDA backend's (bev_map.cu),
+// whatever the thread count.
 void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
-  const std::vector<GroundOffer>& offers = scratch.offers;
-  const bool alone = runsAlone();
   takeOffGrid(map);
-  // Round 1: the slots, and the closest offer per slot.
-  if (alone) {
-    slotsAndClosestAlone(offers, scratch, map);
+  if (tbb::this_task_arena::max_concurrency() > 2) {
+    fillByBands(same_surface_distance, scratch, map);
   } else {
-    slotsAndClosestInParallel(offers, scratch, map);
+    fillInTurn(same_surface_distance, scratch, map);
   }
-  // Round 2: the oldest offer on that surface.
-  const std::vector<int32_t>& slot_of_offer = scratch.slot_of_offer;
-  const std::vector<ClosestKey>& closest = scratch.closest;
-  std::vector<ClosestKey>& oldest = scratch.oldest;
-  parallelFor(offers.size(), [&](size_t i) {
-    const GroundOffer& offer = offers[i];
-    if (offer.cell < 0) return;
-    const int32_t slot = slot_of_offer[i];
-    if (onClosestSurface(offer.range, closestWinsRange(closest[slot]), same_surface_distance)) {
-      keepSmaller(oldest[slot], oldestWinsKey(offer.stamp, offer.source), alone);
-    }
-  });
-  // The offer whose key its slot kept (sources are unique) writes the slot.
-  parallelFor(offers.size(), [&](size_t i) {
-    const GroundOffer& offer = offers[i];
-    if (offer.cell < 0) return;
-    const int32_t slot = slot_of_offer[i];
-    if (oldest[slot] != oldestWinsKey(offer.stamp, offer.source)) return;
-    map.vertex[slot] = offer.vertex;
-    map.range[slot] = offer.range;
-    map.stamp[slot] = offer.stamp;
-  });
 }
 
 void GroundNormalCache::reset(size_t points) {

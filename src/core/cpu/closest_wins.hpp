@@ -52,19 +52,4 @@ class ClosestWins {
   bool single_writer_ = false;
 };
 
-// Keeps the smaller of `target` and `value` for arrays that are not ClosestWins' own (BEV map rounds).
-// Many threads may offer to one target at once unless `single_writer` (runsAlone()), when a plain
-// compare and store does, as in ClosestWins::offerKey().
-template <typename T>
-void keepSmaller(T& target, T value, bool single_writer) {
-  if (single_writer) {
-    if (value < target) target = value;
-    return;
-  }
-  T current = __atomic_load_n(&target, __ATOMIC_RELAXED);
-  while (value < current &&
-         !__atomic_compare_exchange_n(&target, &current, value, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-  }
-}
-
 }  // namespace elo::cpu

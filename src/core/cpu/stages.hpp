@@ -73,12 +73,21 @@ struct GroundOffer {
 // The offers a ground map is filled with (fillGroundMap()) and the fill's own arrays, kept by the
 // backend so that no frame allocates them again (each fresh allocation costs page faults and zeroing).
 struct GroundMapScratch {
-  std::vector<GroundOffer> offers;      // in the order of their sources
-  std::vector<int32_t> first_of_offer;  // per offer: the first offer to its cell (-1: no cell)
+  std::vector<GroundOffer> offers;  // in the order of their sources
+  // The offers grouped by bands of grid rows (fillGroundMap()), their indices, and the counting sort's
+  // own arrays.
+  std::vector<GroundOffer> banded;
+  std::vector<int32_t> banded_index;
+  std::vector<int32_t> band_start;
+  std::vector<int32_t> band_place;
+  // Per grouped offer: the position of its cell's first offer. There, per cell: the closest offer's key
+  // (round 1), the oldest key on that surface (round 2) and that offer's position.
+  std::vector<int32_t> first_of;
+  std::vector<ClosestKey> closest;
+  std::vector<ClosestKey> oldest;
+  std::vector<int32_t> winner;
+  std::vector<int32_t> first_position;  // per offer: its position if it is its cell's first, else -1
   std::vector<int32_t> first_offers;    // per slot: the first offer to its cell
-  std::vector<int32_t> slot_of_offer;   // per offer: its cell's slot
-  std::vector<ClosestKey> closest;      // round 1, per slot: the closest offer's key
-  std::vector<ClosestKey> oldest;       // round 2, per slot: the oldest offer's key on that surface
 };
 
 // bev_map.cpp: the pixels labelled ground, in increasing order.
