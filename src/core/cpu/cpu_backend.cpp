@@ -1,5 +1,7 @@
 #include "core/cpu/cpu_backend.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <utility>
 
 namespace elo::cpu {
@@ -96,13 +98,22 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
     return;
   }
   const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);
+  // The two models fuse side by side: where the ground map is filled on one thread (fillGroundMap()), the
+  // others work through the spherical fusion meanwhile.
   arena_.execute([&] {
-    fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, fusion_scratch_, fused_.nonground);
-    fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_ground_scratch_, fused_.ground);
+    tbb::parallel_invoke(
+        [&] {
+          fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, fusion_scratch_,
+                             fused_.nonground);
+        },
+        [&] {
+          fuseGroundModel(model_.ground, scan_ground_, bev_, model_from_scan, fusion, fused_ground_scratch_,
+                          fused_.ground);
+          ground_normals_.reset(fused_.ground.size());
+        });
   });
   std::swap(model_, fused_);
   model_.initialized = true;
-  ground_normals_.reset(model_.ground.size());
 }
 
 void CpuBackend::resetModel() {
