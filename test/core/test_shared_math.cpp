@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cstring>
 #include <random>
 
 #include "analytic_scene.hpp"
@@ -15,6 +17,7 @@
 #include "core/common/ground.hpp"
 #include "core/common/normals.hpp"
 #include "core/common/point_to_plane.hpp"
+#include "core/cpu/eigen_lanes.hpp"
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/packed_sums.hpp"
 #include "core/cuda/normal_tile.hpp"
@@ -94,6 +97,49 @@ TEST(SymmetricEigen, CollinearAndIsotropicPointsStillGiveAUnitOrthogonalVector) 
   EXPECT_FLOAT_EQ(isotropic.eigenvalues[0], 2.0f);
   EXPECT_FLOAT_EQ(isotropic.eigenvalues[2], 2.0f);
   EXPECT_NEAR(norm(isotropic.smallest), 1.0f, 1e-6f);
+}
+
+// The CPU's 8-lane solve (eigen_lanes.hpp) against symmetricEigen() itself, bit for bit: planes, lines,
+// blobs and nearly coincident eigenvalues of random point sets, and the edge cases of the branches (a
+// zero matrix, equal eigenvalues, diagonal matrices whose largest entry is in each column, two equal
+// eigenvalues, points all in one spot), in lanes of every fill.
+TEST(SymmetricEigen, EightLanesGiveTheScalarSolveBitForBit) {
+  std::mt19937 random(5);
+  const Eigen::Vector3f spreads[] = {{1.0f, 0.5f, 0.2f},  {0.3f, 0.3f, 0.001f}, {2.0f, 0.01f, 0.01f},
+                                     {0.4f, 0.2f, 0.0f},  {1.0f, 1.0f, 1.0f},   {0.5f, 0.5f, 0.0f},
+                                     {1.0f, 0.0f, 0.0f},  {1e-4f, 1e-4f, 1e-5f}};
+  std::vector<SymmetricMatrix3> matrices = {
+      {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f},  {2.0f, 0.0f, 0.0f, 2.0f, 0.0f, 2.0f},
+      {3.0f, 0.0f, 0.0f, 1.0f, 0.0f, 2.0f},  {1.0f, 0.0f, 0.0f, 3.0f, 0.0f, 2.0f},
+      {1.0f, 0.0f, 0.0f, 2.0f, 0.0f, 3.0f},  {1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 4.0f},
+      {4.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f},  {1.0f, 0.5f, 0.0f, 1.0f, 0.0f, 0.5f},
+      covarianceOf(std::vector<Float3>(6, Float3{1.0f, 2.0f, 3.0f}))};
+  for (int trial = 0; trial < 4000; ++trial) {
+    matrices.push_back(covarianceOf(scatteredPoints(random, spreads[trial % 8], 5 + trial % 60)));
+  }
+  const auto bits = [](float value) {
+    uint32_t b;
+    std::memcpy(&b, &value, sizeof(b));
+    return b;
+  };
+  size_t compared = 0;
+  int count = 0;
+  for (size_t first = 0; first < matrices.size(); first += static_cast<size_t>(count)) {
+    count = static_cast<int>(std::min<size_t>(cpu::kEigenLanes - first % 3, matrices.size() - first));  // 6 to 8
+    SymmetricEigen lanes[cpu::kEigenLanes];
+    cpu::symmetricEigens(matrices.data() + first, count, lanes);
+    for (int lane = 0; lane < count; ++lane) {
+      const SymmetricEigen scalar = symmetricEigen(matrices[first + lane]);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_EQ(bits(lanes[lane].eigenvalues[i]), bits(scalar.eigenvalues[i])) << "matrix " << first + lane;
+      }
+      EXPECT_EQ(bits(lanes[lane].smallest.x), bits(scalar.smallest.x)) << "matrix " << first + lane;
+      EXPECT_EQ(bits(lanes[lane].smallest.y), bits(scalar.smallest.y)) << "matrix " << first + lane;
+      EXPECT_EQ(bits(lanes[lane].smallest.z), bits(scalar.smallest.z)) << "matrix " << first + lane;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, matrices.size());
 }
 
 TEST(PlaneFit, RecoversAPlaneAndItsFlatness) {

@@ -170,17 +170,21 @@ struct PlaneFit {
   bool valid = false;
 };
 
-// The plane of the points whose moments are given: eigen-decomposition of their covariance (Eq. 10-11).
-ELO_HOST_DEVICE inline PlaneFit fitPlane(const PointMoments& moments) {
+// The plane of points whose covariance has the eigen-decomposition `eigen` (Eq. 10-11).
+ELO_HOST_DEVICE inline PlaneFit planeOf(const SymmetricEigen& eigen) {
   PlaneFit fit;
-  if (moments.count < 3) return fit;
-  const SymmetricEigen eigen = symmetricEigen(moments.covariance());
   const float sum = eigen.eigenvalues[0] + eigen.eigenvalues[1] + eigen.eigenvalues[2];
   if (!(sum > 0.0f)) return fit;
   fit.normal = eigen.smallest / norm(eigen.smallest);
   fit.curvature = (eigen.eigenvalues[0] > 0.0f ? eigen.eigenvalues[0] : 0.0f) / sum;
   fit.valid = isFinite(fit.normal);
   return fit;
+}
+
+// The plane of the points whose moments are given: eigen-decomposition of their covariance.
+ELO_HOST_DEVICE inline PlaneFit fitPlane(const PointMoments& moments) {
+  if (moments.count < 3) return {};
+  return planeOf(symmetricEigen(moments.covariance()));
 }
 
 // Below this smallest eigenvalue of their horizontal spread (1 cm across the line) ground points lie on

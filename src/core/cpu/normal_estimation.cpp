@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/common/normals.hpp"
+#include "core/cpu/eigen_lanes.hpp"
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
@@ -181,31 +182,60 @@ class NormalEstimator {
         scan_(scan),
         image_(scan.image) {}
 
-  void estimate(size_t pixel) const {
-    if (scan_.label[pixel] != PixelLabel::nonground) return;
-    const int row = static_cast<int>(pixel) / projection_.cols;
-    const int col = static_cast<int>(pixel) % projection_.cols;
-    if (config_.method == NormalMethod::cross_product) {
-      image_.normal[pixel] = toVec3f(crossProductNormal(ScanPixels(scan_), row, col));
-      return;
+  // The normals of the pixels [begin, end). Each pixel's window is summed alone; the first plane fits of
+  // kEigenLanes pixels are solved at once (eigen_lanes.hpp), giving what fitEnough() gives each.
+  void estimate(size_t begin, size_t end) const {
+    FirstFits pending;
+    for (size_t pixel = begin; pixel < end; ++pixel) {
+      if (scan_.label[pixel] != PixelLabel::nonground) continue;
+      if (config_.method == NormalMethod::cross_product) {
+        const int row = static_cast<int>(pixel) / projection_.cols;
+        const int col = static_cast<int>(pixel) % projection_.cols;
+        image_.normal[pixel] = toVec3f(crossProductNormal(ScanPixels(scan_), row, col));
+        continue;
+      }
+      const Window window = windowOf(pixel);
+      PointMoments& moments = pending.moments[pending.count];
+      if (!gatherNeighbours(pixel, window, config_.method == NormalMethod::range_adaptive, nullptr, moments)) continue;
+      if (moments.count < params_.min_neighbours || moments.count < 3) continue;  // fitEnough() and fitPlane() give none
+      pending.pixel[pending.count] = pixel;
+      pending.window[pending.count] = window;
+      if (++pending.count == kEigenLanes) finish(pending);
     }
-    const bool adaptive = config_.method == NormalMethod::range_adaptive;
-    const Window window = windowOf(pixel);
-    PointMoments moments;
-    if (!gatherNeighbours(pixel, window, adaptive, nullptr, moments)) return;
-    PlaneFit fit = fitEnough(moments, params_);
-    if (!fit.valid) return;
-    if (params_.refit) {
-      PointMoments on_plane;
-      gatherNeighbours(pixel, window, true, &fit.normal, on_plane);
-      if (on_plane.count != moments.count) fit = fitEnough(on_plane, params_);
-      if (!fit.valid) return;
-    }
-    if (fit.curvature > config_.max_curvature) return;
-    image_.normal[pixel] = toVec3f(towardsSensor(fit.normal, toFloat3(image_.vertex[pixel])));
+    finish(pending);
   }
 
  private:
+  // Up to kEigenLanes pixels whose first plane fit is due.
+  struct FirstFits {
+    int count = 0;
+    size_t pixel[kEigenLanes];
+    Window window[kEigenLanes];
+    PointMoments moments[kEigenLanes];
+  };
+
+  // The pending pixels' first fits, then each one's refit and curvature test as fitEnough() leaves them.
+  void finish(FirstFits& pending) const {
+    SymmetricMatrix3 covariances[kEigenLanes];
+    for (int i = 0; i < pending.count; ++i) covariances[i] = pending.moments[i].covariance();
+    SymmetricEigen eigens[kEigenLanes];
+    symmetricEigens(covariances, pending.count, eigens);
+    for (int i = 0; i < pending.count; ++i) {
+      const size_t pixel = pending.pixel[i];
+      PlaneFit fit = planeOf(eigens[i]);
+      if (!fit.valid) continue;
+      if (params_.refit) {
+        PointMoments on_plane;
+        gatherNeighbours(pixel, pending.window[i], true, &fit.normal, on_plane);
+        if (on_plane.count != pending.moments[i].count) fit = fitEnough(on_plane, params_);
+        if (!fit.valid) continue;
+      }
+      if (fit.curvature > config_.max_curvature) continue;
+      image_.normal[pixel] = toVec3f(towardsSensor(fit.normal, toFloat3(image_.vertex[pixel])));
+    }
+    pending.count = 0;
+  }
+
   Window windowOf(size_t pixel) const {
     if (config_.method == NormalMethod::eigen) {
       return {config_.max_window_width / 2, config_.max_window_height / 2};
@@ -257,7 +287,7 @@ void estimateNormals(const NormalConfig& config, const SphericalProjection& proj
                      ScanImage& scan) {
   scratch.fill(scan, config.max_window_width);
   const NormalEstimator estimator(config, projection, scratch, scan);
-  parallelFor(scan.image.pixelCount(), [&](size_t pixel) { estimator.estimate(pixel); });
+  parallelForBlocks(scan.image.pixelCount(), [&](size_t begin, size_t end) { estimator.estimate(begin, end); });
 }
 
 }  // namespace elo::cpu
