@@ -37,6 +37,7 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
   size_t occupied = 0;
+  scan_ground_built_ = false;
   arena_.execute([&] {
     occupied = projectCloud(cloud, config_.sensor, spherical_, ring_rows_, deskew, stamp, winners_, placed_, scan_);
   });
@@ -46,11 +47,13 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
 void CpuBackend::deskewScan(const Vector6d& velocity) {
   if (scan_times_ == TimeSource::none) return;
   const SweepVelocity next = toSweepVelocity(velocity);
+  scan_ground_built_ = false;
   arena_.execute([&] { cpu::deskewScan(scan_velocity_, next, scan_); });
   scan_velocity_ = next;
 }
 
 void CpuBackend::segmentGround() {
+  scan_ground_built_ = false;
   arena_.execute([&] {
     if (config_.registration.terms == CostTerms::spherical_all) {
       labelAllNonground(scan_);
@@ -61,18 +64,30 @@ void CpuBackend::segmentGround() {
   });
 }
 
+// The scan's ground map needs only the labels, so it is built beside the normals: where its fill runs on
+// one thread (fillGroundMap()), the others work through the normals meanwhile. buildGroundMap() then has
+// nothing left to do.
 void CpuBackend::estimateNormals() {
   arena_.execute([&] {
-    cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_);
-    registration_pixels_ = registrationPixels(scan_);
+    tbb::parallel_invoke(
+        [&] {
+          cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_);
+          registration_pixels_ = registrationPixels(scan_);
+        },
+        [&] { buildScanGroundMap(); });
   });
 }
 
 void CpuBackend::buildGroundMap() {
-  arena_.execute([&] {
-    cpu::buildGroundMap(scan_, ground_pixels_, bev_, static_cast<float>(config_.model.same_surface_distance),
-                        scan_ground_scratch_, scan_ground_);
-  });
+  arena_.execute([&] { buildScanGroundMap(); });
+}
+
+// In the arena: the ground map of the scan as it is, unless it is built already.
+void CpuBackend::buildScanGroundMap() {
+  if (scan_ground_built_) return;
+  cpu::buildGroundMap(scan_, ground_pixels_, bev_, static_cast<float>(config_.model.same_surface_distance),
+                      scan_ground_scratch_, scan_ground_);
+  scan_ground_built_ = true;
 }
 
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {

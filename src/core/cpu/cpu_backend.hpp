@@ -26,6 +26,8 @@ class CpuBackend final : public Backend {
   const Model& model() override { return model_; }
 
  private:
+  void buildScanGroundMap();
+
   Config config_;
   SphericalProjection spherical_;
   BevProjection bev_;
@@ -43,6 +45,7 @@ class CpuBackend final : public Backend {
   GroundMapScratch scan_ground_scratch_;
   GroundMapScratch fused_ground_scratch_;
   BevImage scan_ground_;
+  bool scan_ground_built_ = false;  // for the scan's vertices and labels as they are
   Model model_;
   Model fused_;  // the model update writes here, then swaps with model_
   ClosestWins winners_;  // the projection's closest point per pixel
