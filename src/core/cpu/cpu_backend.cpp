@@ -1,6 +1,6 @@
 #include "core/cpu/cpu_backend.hpp"
 
-#include <tbb/parallel_invoke.h>
+#include "core/cpu/parallel.hpp"
 
 #include <utility>
 
@@ -69,7 +69,7 @@ void CpuBackend::segmentGround() {
 // nothing left to do.
 void CpuBackend::estimateNormals() {
   arena_.execute([&] {
-    tbb::parallel_invoke(
+    parallelInvoke(
         [&] {
           cpu::estimateNormals(config_.normals, spherical_, normal_scratch_, scan_);
           registration_pixels_ = registrationPixels(scan_);
@@ -116,7 +116,7 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   // The two models fuse side by side: where the ground map is filled on one thread (fillGroundMap()), the
   // others work through the spherical fusion meanwhile.
   arena_.execute([&] {
-    tbb::parallel_invoke(
+    parallelInvoke(
         [&] {
           fuseSphericalModel(model_.nonground, scan_, spherical_, model_from_scan, fusion, fusion_scratch_,
                              fused_.nonground);

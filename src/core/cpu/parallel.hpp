@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -116,6 +117,27 @@ void parallelSelect(size_t count, const Keep& keep, std::vector<int32_t>& select
   writing.beforeLoop(write_block);
   tbb::parallel_for(size_t{0}, blocks, write_block);
   writing.afterLoop();
+}
+
+// Runs `first()` and `second()` side by side in the current arena (each may run parallel loops of its
+// own), returning when both have.
+template <typename First, typename Second>
+void parallelInvoke(const First& first, const Second& second) {
+  ForkJoinOrder order;
+  const auto run_first = [&] {
+    ForkJoinOrder::taskStarts();
+    first();
+    order.taskEnds();
+  };
+  const auto run_second = [&] {
+    ForkJoinOrder::taskStarts();
+    second();
+    order.taskEnds();
+  };
+  order.beforeLoop(run_first);
+  order.beforeLoop(run_second);
+  tbb::parallel_invoke(run_first, run_second);
+  order.afterLoop();
 }
 
 // Whether the loops of the current arena run on one thread only (a backend with `runtime.threads` 1).
