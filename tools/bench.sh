@@ -28,10 +28,15 @@ run() {  # elo_run over $1 with the other arguments, printing its summary
   "$bin/elo_run" --input "$input" --output "$out/poses.txt" --quiet "$@" | sed -n '/^stage/,$p'
 }
 
+# The number of scans in a sequence directory: a KITTI-style one's velodyne/*.bin, else its files.
+scan_count() {
+  if [ -d "$1/velodyne" ]; then ls "$1/velodyne" | wc -l; else ls "$1" | wc -l; fi
+}
+
 # scaling: the frame-to-model scaling table of the CPU backend over $scans (see the top).
 scaling() {
   local repeat=${BENCH_REPEAT:-3} threads run_index
-  echo "=== CPU, f2m, scaling over threads, $(basename "$scans") ($(ls "$scans" | wc -l) scans), fastest of $repeat runs"
+  echo "=== CPU, f2m, scaling over threads, $(basename "$scans") ($(scan_count "$scans") scans), fastest of $repeat runs"
   for threads in $thread_settings; do
     for run_index in $(seq "$repeat"); do
       local option=()
@@ -78,7 +83,7 @@ PYTHON
 if [ -d "$scans" ]; then
   scaling
   for threads in 1 2; do
-    echo "=== CPU, f2f, $threads thread(s), $(basename "$scans") ($(ls "$scans" | wc -l) scans)"
+    echo "=== CPU, f2f, $threads thread(s), $(basename "$scans") ($(scan_count "$scans") scans)"
     run "$scans" --mode f2f --threads "$threads"
   done
 else
