@@ -216,6 +216,7 @@ class NormalEstimator {
 
   // The pending pixels' first fits, then each one's refit and curvature test as fitEnough() leaves them.
   void finish(FirstFits& pending) const {
+    if (pending.count == 0) return;
     SymmetricMatrix3 covariances[kEigenLanes];
     for (int i = 0; i < pending.count; ++i) covariances[i] = pending.moments[i].covariance();
     SymmetricEigen eigens[kEigenLanes];

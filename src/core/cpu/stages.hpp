@@ -74,14 +74,15 @@ struct GroundOffer {
 // backend so that no frame allocates them again (each fresh allocation costs page faults and zeroing).
 struct GroundMapScratch {
   std::vector<GroundOffer> offers;  // in the order of their sources
-  // The offers grouped by bands of grid rows (fillGroundMap()), their indices, and the counting sort's
-  // own arrays.
+  // The offers grouped by bands of grid cells (fillGroundMap() from three threads on), their indices,
+  // and the counting sort's own arrays.
   std::vector<GroundOffer> banded;
   std::vector<int32_t> banded_index;
   std::vector<int32_t> band_start;
   std::vector<int32_t> band_place;
   // Per grouped offer: the position of its cell's first offer. There, per cell: the closest offer's key
-  // (round 1), the oldest key on that surface (round 2) and that offer's position.
+  // (round 1), the oldest key on that surface (round 2) and that offer's position. (Taking the offers in
+  // turn, first_of holds each offer's slot, and oldest and winner are per slot.)
   std::vector<int32_t> first_of;
   std::vector<ClosestKey> closest;
   std::vector<ClosestKey> oldest;

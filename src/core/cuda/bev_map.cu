@@ -1,8 +1,8 @@
 // Sec. III-C.2 and III-D on the GPU: BEV maps that keep in each cell the oldest point on the surface
 // closest to the sensor (the two rounds of model_update.hpp).
 //
-// Order of the compact points. The CPU backend offers sources one at a time (fillGroundMap()): a cell
-// takes the next slot when it is first offered a point. Here every source offers itself to its cell
+// Order of the compact points. The CPU backend's fill (fillGroundMap()) gives a cell the next slot when
+// it is first offered a point, in source order, as one thread offering the sources in turn would. Here every source offers itself to its cell
 // twice at once, with an atomicMin of its closest-wins key (the first round of which point stays) and of
 // its source index (which source arrived first). A first arrival's slot is the number of first arrivals
 // before it in source order, so both backends' maps agree element by element, in the same order.
