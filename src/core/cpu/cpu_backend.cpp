@@ -93,15 +93,20 @@ void CpuBackend::buildScanGroundMap() {
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
   NormalEquations sums;
   const CostTerms terms = config_.registration.terms;
+  // The two terms' sums are independent: they run side by side, so that the end of one loop, where
+  // threads run out of blocks, overlaps the other.
   arena_.execute([&] {
-    if (terms != CostTerms::bev_ground) {
-      sums.nonground = nongroundSums(scan_, registration_pixels_, model_.nonground, spherical_, model_from_scan,
-                                     kernel_scale, config_.registration);
-    }
-    if (terms == CostTerms::fused || terms == CostTerms::bev_ground) {
-      sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,
-                               config_.registration, config_.bev);
-    }
+    parallelInvoke(
+        [&] {
+          if (terms == CostTerms::bev_ground) return;
+          sums.nonground = nongroundSums(scan_, registration_pixels_, model_.nonground, spherical_, model_from_scan,
+                                         kernel_scale, config_.registration);
+        },
+        [&] {
+          if (terms != CostTerms::fused && terms != CostTerms::bev_ground) return;
+          sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,
+                                   config_.registration, config_.bev);
+        });
   });
   return sums;
 }
