@@ -1,6 +1,8 @@
 // Sec. III-C.2: the bird's-eye-view map of ground points, and the normals of the BEV model fitted to
 // the model points nearest an associated cell (groundNormal() of association.hpp, shared with the CUDA
 // backend).
+#include <algorithm>
+
 #include "core/common/association.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/cpu/image_views.hpp"
@@ -80,17 +82,21 @@ void takeOffGrid(BevImage& map) {
 constexpr int kBandShift = 13;
 
 // Copies the offers, grouped by band, into scratch.banded (band b's from band_start[b] to band_start[b + 1],
-// each band's in the offers' order, with their indices in banded_index), leaving out those offered to no
-// cell. A counting sort over fixed blocks of offers: each block counts its offers per band, the counts
+// each band's in the offers' order), leaving out those offered to no cell. A counting sort over fixed blocks of offers: each block counts its offers per band, the counts
 // place every (band, block) run one after another, and each block writes its own runs, so the result is
 // the same whatever the thread count.
 void groupByBand(const std::vector<GroundOffer>& offers, size_t bands, GroundMapScratch& scratch) {
   const size_t blocks = (offers.size() + kFixedBlock - 1) / kFixedBlock;
   const auto band_of = [](int32_t cell) { return static_cast<size_t>(cell) >> kBandShift; };
   std::vector<int32_t>& place = scratch.band_place;  // [block * bands + band]: a count, then where the run starts
-  place.assign(blocks * bands, 0);
+  place.resize(blocks * bands);
+  // The count pass also marks every offer "not a first offer" for fillBand().
+  scratch.first_position.resize(offers.size());
   parallelFor(blocks, [&](size_t block) {
+    std::fill(place.begin() + static_cast<std::ptrdiff_t>(block * bands),
+              place.begin() + static_cast<std::ptrdiff_t>((block + 1) * bands), 0);
     for (size_t i = block * kFixedBlock; i < std::min(offers.size(), (block + 1) * kFixedBlock); ++i) {
+      scratch.first_position[i] = -1;
       if (offers[i].cell >= 0) ++place[block * bands + band_of(offers[i].cell)];
     }
   });
@@ -110,45 +116,44 @@ void groupByBand(const std::vector<GroundOffer>& offers, size_t bands, GroundMap
   });
   const size_t grouped = static_cast<size_t>(band_start[bands]);
   scratch.banded.resize(grouped);
-  scratch.banded_index.resize(grouped);
   parallelFor(blocks, [&](size_t block) {
     for (size_t i = block * kFixedBlock; i < std::min(offers.size(), (block + 1) * kFixedBlock); ++i) {
-      if (offers[i].cell < 0) continue;
-      const int32_t at = place[block * bands + band_of(offers[i].cell)]++;
-      scratch.banded[at] = offers[i];
-      scratch.banded_index[at] = static_cast<int32_t>(i);
+      const GroundOffer& offer = offers[i];
+      if (offer.cell < 0) continue;
+      scratch.banded[place[block * bands + band_of(offer.cell)]++] = {offer.cell, offer.range, offer.stamp,
+                                                                      offer.source, static_cast<int32_t>(i)};
     }
   });
 }
 
 // Both rounds for the cells of one band: its grouped offers [begin, end), in their order. A cell's state
 // lives at its first offer's position: the grid holds that position meanwhile, `closest` and `oldest` the
-// rounds' keys there, `winner` the position of the offer with the oldest key.
+// rounds' keys there, `winner` the index of the offer with the oldest key.
 void fillBand(size_t begin, size_t end, float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
-  const std::vector<GroundOffer>& banded = scratch.banded;
+  const std::vector<BandedOffer>& banded = scratch.banded;
   for (size_t at = begin; at < end; ++at) {
     if (at + kCellPrefetchDistance < end) __builtin_prefetch(&map.point_of_cell[banded[at + kCellPrefetchDistance].cell], 1);
-    const GroundOffer& offer = banded[at];
+    const BandedOffer& offer = banded[at];
     int32_t& first = map.point_of_cell[offer.cell];
     const ClosestKey key = closestWinsKey(offer.range, offer.source);
     if (first < 0) {
       first = static_cast<int32_t>(at);
       scratch.closest[at] = key;
       scratch.oldest[at] = kNoClosestKey;
-      scratch.first_position[scratch.banded_index[at]] = first;
+      scratch.first_position[offer.index] = first;
     } else if (key < scratch.closest[first]) {
       scratch.closest[first] = key;
     }
     scratch.first_of[at] = first;
   }
   for (size_t at = begin; at < end; ++at) {
-    const GroundOffer& offer = banded[at];
+    const BandedOffer& offer = banded[at];
     const int32_t first = scratch.first_of[at];
     if (!onClosestSurface(offer.range, closestWinsRange(scratch.closest[first]), same_surface_distance)) continue;
     const ClosestKey key = oldestWinsKey(offer.stamp, offer.source);
     if (key < scratch.oldest[first]) {
       scratch.oldest[first] = key;
-      scratch.winner[first] = static_cast<int32_t>(at);
+      scratch.winner[first] = offer.index;
     }
   }
 }
@@ -209,7 +214,6 @@ void fillByBands(float same_surface_distance, GroundMapScratch& scratch, BevImag
   const size_t bands = (map.cellCount() >> kBandShift) + 1;
   groupByBand(offers, bands, scratch);
   const size_t grouped = scratch.banded.size();
-  scratch.first_position.assign(offers.size(), -1);
   scratch.first_of.resize(grouped);
   scratch.closest.resize(grouped);
   scratch.oldest.resize(grouped);
@@ -227,9 +231,8 @@ void fillByBands(float same_surface_distance, GroundMapScratch& scratch, BevImag
   forEachPrefetchingCells(
       slots, map.point_of_cell, [&](size_t slot) { return offers[first_offers[slot]].cell; },
       [&](size_t slot) {
-        const int32_t first = scratch.first_position[first_offers[slot]];
-        const GroundOffer& kept = scratch.banded[scratch.winner[first]];
-        const int32_t cell = scratch.banded[first].cell;
+        const GroundOffer& kept = offers[scratch.winner[scratch.first_position[first_offers[slot]]]];
+        const int32_t cell = offers[first_offers[slot]].cell;
         map.cell[slot] = cell;
         map.point_of_cell[cell] = static_cast<int32_t>(slot);
         map.vertex[slot] = kept.vertex;

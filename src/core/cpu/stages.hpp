@@ -70,18 +70,27 @@ struct GroundOffer {
       : cell(to_cell), vertex(point), range(norm(toFloat3(point))), stamp(observed_at), source(from_source) {}
 };
 
+// An offer as the fill's bands take it (fillGroundMap()): what its two rounds read, and its index among
+// the offers.
+struct BandedOffer {
+  int32_t cell;
+  float range;
+  float stamp;
+  uint32_t source;
+  int32_t index;
+};
+
 // The offers a ground map is filled with (fillGroundMap()) and the fill's own arrays, kept by the
 // backend so that no frame allocates them again (each fresh allocation costs page faults and zeroing).
 struct GroundMapScratch {
   std::vector<GroundOffer> offers;  // in the order of their sources
-  // The offers grouped by bands of grid cells (fillGroundMap() from three threads on), their indices,
-  // and the counting sort's own arrays.
-  std::vector<GroundOffer> banded;
-  std::vector<int32_t> banded_index;
+  // The offers grouped by bands of grid cells (fillGroundMap() from three threads on), and the counting
+  // sort's own arrays.
+  std::vector<BandedOffer> banded;
   std::vector<int32_t> band_start;
   std::vector<int32_t> band_place;
   // Per grouped offer: the position of its cell's first offer. There, per cell: the closest offer's key
-  // (round 1), the oldest key on that surface (round 2) and that offer's position. (Taking the offers in
+  // (round 1), the oldest key on that surface (round 2) and that offer's index. (Taking the offers in
   // turn, first_of holds each offer's slot, and oldest and winner are per slot.)
   std::vector<int32_t> first_of;
   std::vector<ClosestKey> closest;
