@@ -261,7 +261,7 @@ void GroundNormalCache::reset(size_t points) {
     normals_.resize(capacity_);
     states_ = std::make_unique<std::atomic<uint8_t>[]>(capacity_);
   }
-  for (size_t i = 0; i < points; ++i) states_[i].store(unknown, std::memory_order_relaxed);
+  parallelFor(points, [&](size_t i) { states_[i].store(unknown, std::memory_order_relaxed); });
 }
 
 Vec3f GroundNormalCache::normal(const BevImage& model, const BevProjection& projection, const BevConfig& config,

@@ -113,8 +113,10 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
 
 void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float stamp) {
   if (!model_.initialized || config_.model.mode == RegistrationMode::frame_to_frame) {
-    arena_.execute([&] { copyScanToModel(scan_, scan_ground_, model_); });
-    ground_normals_.reset(model_.ground.size());
+    arena_.execute([&] {
+      copyScanToModel(scan_, scan_ground_, model_);
+      ground_normals_.reset(model_.ground.size());
+    });
     return;
   }
   const ModelFusion fusion = ModelFusion::fromConfig(config_.model, stamp);

@@ -116,7 +116,8 @@ void fillGroundMap(float same_surface_distance, GroundMapScratch& scratch, BevIm
 // value any other would.
 class GroundNormalCache {
  public:
-  // Forgets every normal; call whenever the model changes, with its new point count.
+  // Forgets every normal, across the threads of the current arena; call whenever the model changes, with
+  // its new point count.
   void reset(size_t points);
   // Starts loading what normal() will read for `point`.
   void prefetch(int32_t point) const {
