@@ -1,5 +1,7 @@
 // Sec. III-B.1: spherical projection of the scan into an index range image, closest point per pixel, each
 // point deskewed first. The per-point math is shared with the CUDA backend (scan_projection.hpp).
+#include <type_traits>
+
 #include "core/common/eigen_interop.hpp"
 #include "core/common/scan_projection.hpp"
 #include "core/cpu/parallel.hpp"
@@ -31,21 +33,37 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
   placed.resize(cloud.points.size());
   winners.setSingleWriter(runsAlone());
   // Each point is corrected, deskewed and timed alone; the pixels of kPixelLanes points are found at once.
-  parallelFor((cloud.points.size() + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
-    pixelsOfGroup(
-        projection, group * kPixelLanes, cloud.points.size(),
-        [&](size_t i, Float3& vertex) {
-          const Float3 raw = toFloat3(cloud.points[i]);
-          if (!isFinite(raw) || !scanPointVertex(correction, deskew, static_cast<int>(i), raw, placed[i])) return false;
-          vertex = placed[i].vertex;
-          return true;
-        },
-        [&](size_t i, int row, int col, float range) {
-          if (!beamRow(rings.of(i), rings.rows, rings.count, projection.rows, row)) return;
-          placed[i].pixel = row * projection.cols + col;
-          winners.offer(placed[i].pixel, range, static_cast<uint32_t>(i));
-        });
-  });
+  // Without a correction and a deskew a point is placed as measured, at time 0 (what scanPointVertex()
+  // then gives), in a loop built without their tests.
+  const auto place_points = [&](auto as_measured) {
+    parallelFor((cloud.points.size() + kPixelLanes - 1) / kPixelLanes, [&](size_t group) {
+      pixelsOfGroup(
+          projection, group * kPixelLanes, cloud.points.size(),
+          [&](size_t i, Float3& vertex) {
+            const Float3 raw = toFloat3(cloud.points[i]);
+            if (!isFinite(raw)) return false;
+            if constexpr (decltype(as_measured)::value) {
+              placed[i].measured = raw;
+              placed[i].vertex = raw;
+              placed[i].time = 0.0f;
+            } else if (!scanPointVertex(correction, deskew, static_cast<int>(i), raw, placed[i])) {
+              return false;
+            }
+            vertex = placed[i].vertex;
+            return true;
+          },
+          [&](size_t i, int row, int col, float range) {
+            if (!beamRow(rings.of(i), rings.rows, rings.count, projection.rows, row)) return;
+            placed[i].pixel = row * projection.cols + col;
+            winners.offer(placed[i].pixel, range, static_cast<uint32_t>(i));
+          });
+    });
+  };
+  if (!correction.active && deskew.timing.source == TimeSource::none && deskew.velocity.isZero()) {
+    place_points(std::true_type{});
+  } else {
+    place_points(std::false_type{});
+  }
 
   // Each pixel takes its winner (which empties the pixel for the next scan). The winner's range is the
   // one its key holds: the norm of the same vertex.
