@@ -131,21 +131,22 @@ void groupByBand(const std::vector<GroundOffer>& offers, size_t bands, GroundMap
 // rounds' keys there, `winner` the index of the offer with the oldest key.
 void fillBand(size_t begin, size_t end, float same_surface_distance, GroundMapScratch& scratch, BevImage& map) {
   const std::vector<BandedOffer>& banded = scratch.banded;
-  for (size_t at = begin; at < end; ++at) {
-    if (at + kCellPrefetchDistance < end) __builtin_prefetch(&map.point_of_cell[banded[at + kCellPrefetchDistance].cell], 1);
-    const BandedOffer& offer = banded[at];
-    int32_t& first = map.point_of_cell[offer.cell];
-    const ClosestKey key = closestWinsKey(offer.range, offer.source);
-    if (first < 0) {
-      first = static_cast<int32_t>(at);
-      scratch.closest[at] = key;
-      scratch.oldest[at] = kNoClosestKey;
-      scratch.first_position[offer.index] = first;
-    } else if (key < scratch.closest[first]) {
-      scratch.closest[first] = key;
-    }
-    scratch.first_of[at] = first;
-  }
+  prefetchingCells(
+      begin, end, map.point_of_cell, [&](size_t at) { return banded[at].cell; },
+      [&](size_t at) {
+        const BandedOffer& offer = banded[at];
+        int32_t& first = map.point_of_cell[offer.cell];
+        const ClosestKey key = closestWinsKey(offer.range, offer.source);
+        if (first < 0) {
+          first = static_cast<int32_t>(at);
+          scratch.closest[at] = key;
+          scratch.oldest[at] = kNoClosestKey;
+          scratch.first_position[offer.index] = first;
+        } else if (key < scratch.closest[first]) {
+          scratch.closest[first] = key;
+        }
+        scratch.first_of[at] = first;
+      });
   for (size_t at = begin; at < end; ++at) {
     const BandedOffer& offer = banded[at];
     const int32_t first = scratch.first_of[at];
