@@ -59,9 +59,10 @@ struct ScanImage {
   SphericalImage image;           // every projected point, deskewed; normals only on non-ground pixels
   std::vector<int32_t> point_index;  // cloud index per pixel, -1 when empty
   std::vector<PixelLabel> label;
-  // Per occupied pixel, so that the scan can be deskewed again in place: its point as measured (after
-  // the elevation correction, in the sensor frame of its firing instant) and its firing time relative
-  // to the scan's reference instant (s).
+  // Per occupied pixel of a scan with per-point times, so that the scan can be deskewed again in place:
+  // its point as measured (after the elevation correction, in the sensor frame of its firing instant) and
+  // its firing time relative to the scan's reference instant (s). A scan without times is not deskewed
+  // again, and the CPU backend leaves these as they were.
   std::vector<Vec3f> measured;
   std::vector<float> time;
 

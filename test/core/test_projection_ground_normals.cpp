@@ -167,6 +167,52 @@ TEST(Projection, PixelLanesGivePixelOfsPixelsBitForBit) {
 }
 #endif
 
+// The projection of points placed as measured reads them straight from the cloud, a whole group of 8
+// with vector loads: every point pixelOf() accepts is found once, with its pixel and norm bit for bit,
+// the others (not finite, out of range, out of the image) not at all, in the groups and in the tail.
+TEST(Projection, PointsReadEightAtOnceGivePixelOfsPixels) {
+  const Config config;
+  const SphericalProjection projection = SphericalProjection::fromConfig(config.sensor);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> xyz = {nan, 1.0f, 1.0f, 1.0f, -inf, 1.0f, 5.0f, 0.0f, nan, 0.0f, 0.0f, 0.0f, 200.0f, 0.0f, 0.0f};
+  std::mt19937 random(23);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> scale(-1.0f, 2.5f);
+  while (xyz.size() < 3 * 20005) {
+    const float size = std::pow(10.0f, scale(random));
+    for (const float axis : {1.0f, 1.0f, 0.3f}) xyz.push_back(axis * size * unit(random));
+  }
+  const size_t count = xyz.size() / 3;
+  std::vector<int> found_row(count, -1), found_col(count, -1), times_found(count, 0);
+  std::vector<float> found_range(count, 0.0f);
+  for (size_t first = 0; first < count; first += cpu::kPixelLanes) {
+    cpu::pixelsOfPoints(projection, xyz.data(), first, count, [&](size_t i, int row, int col, float range) {
+      ++times_found[i];
+      found_row[i] = row;
+      found_col[i] = col;
+      found_range[i] = range;
+    });
+  }
+  size_t accepted = 0;
+  for (size_t i = 0; i < count; ++i) {
+    const Float3 p{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+    int row = 0;
+    int col = 0;
+    const bool in_image = isFinite(p) && projection.pixelOf(p, row, col);
+    ASSERT_EQ(times_found[i], in_image ? 1 : 0) << i << ": " << p.x << " " << p.y << " " << p.z;
+    if (!in_image) continue;
+    ++accepted;
+    EXPECT_EQ(found_row[i], row) << i;
+    EXPECT_EQ(found_col[i], col) << i;
+    const float expected_range = norm(p);
+    EXPECT_EQ(std::memcmp(&found_range[i], &expected_range, sizeof(float)), 0) << i;
+  }
+  EXPECT_EQ(count % cpu::kPixelLanes, 5u);  // a tail shorter than a group
+  EXPECT_GT(accepted, count / 8);
+  EXPECT_LT(accepted, count * 7 / 8);
+}
+
 // Closest-wins keys taken with plain stores by one writer, or with compare-and-swap by many, keep the
 // same smallest key per pixel, and taking them leaves every pixel empty.
 TEST(Projection, ClosestWinsKeepsTheSmallestKeyWithOneWriterAsWithMany) {

@@ -37,6 +37,9 @@ class ClosestWins {
     }
   }
 
+  // Asks for the pixel's key ahead of an offer.
+  void prefetch(size_t pixel) const { __builtin_prefetch(&keys_[pixel], 1); }
+
   // The pixel's key so far (kNoClosestKey: no offer).
   ClosestKey key(size_t pixel) const { return keys_[pixel].load(std::memory_order_relaxed); }
   // The pixel's key (kNoClosestKey: no offer), leaving the pixel empty. Only once every offer is in, and

@@ -88,6 +88,40 @@ inline unsigned pixelsOfLanes(const SphericalProjection& projection, __m256 px, 
   return static_cast<unsigned>(_mm256_movemask_ps(accepted));
 }
 
+// Points [0, kPixelLanes) of the array `points` (x, y, z after one another, as Vec3f and Float3 lay
+// them out) as lanes of x, y and z: three loads of 128-bit pairs and five shuffles instead of 24
+// scalar loads and inserts.
+inline void loadPointLanes(const float* points, __m256& x, __m256& y, __m256& z) {
+  // [x0 y0 z0 x1 | x4 y4 z4 x5], [y1 z1 x2 y2 | y5 z5 x6 y6], [z2 x3 y3 z3 | z6 x7 y7 z7]
+  const __m256 m03 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(points)), _mm_loadu_ps(points + 12), 1);
+  const __m256 m14 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(points + 4)), _mm_loadu_ps(points + 16), 1);
+  const __m256 m25 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(points + 8)), _mm_loadu_ps(points + 20), 1);
+  const __m256 xy = _mm256_shuffle_ps(m14, m25, _MM_SHUFFLE(2, 1, 3, 2));  // [x2 y2 x3 y3 | x6 y6 x7 y7]
+  const __m256 yz = _mm256_shuffle_ps(m03, m14, _MM_SHUFFLE(1, 0, 2, 1));  // [y0 z0 y1 z1 | y4 z4 y5 z5]
+  x = _mm256_shuffle_ps(m03, xy, _MM_SHUFFLE(2, 0, 3, 0));
+  y = _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0));
+  z = _mm256_shuffle_ps(yz, m25, _MM_SHUFFLE(3, 0, 3, 1));
+}
+
+// Bit k set where lane k of x, y and z is finite (x - x is 0 for a finite x, NaN otherwise).
+inline unsigned finiteLanes(__m256 x, __m256 y, __m256 z) {
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 finite = _mm256_and_ps(
+      _mm256_cmp_ps(_mm256_sub_ps(x, x), zero, _CMP_EQ_OQ),
+      _mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(y, y), zero, _CMP_EQ_OQ), _mm256_cmp_ps(_mm256_sub_ps(z, z), zero, _CMP_EQ_OQ)));
+  return static_cast<unsigned>(_mm256_movemask_ps(finite));
+}
+
+// found(first + k, ...) for each lane k set in `accepted`, in order.
+template <typename Found>
+void foundLanes(size_t first, unsigned accepted, const int* row, const int* col, const float* range,
+                const Found& found) {
+  for (; accepted != 0; accepted &= accepted - 1) {
+    const int lane = __builtin_ctz(accepted);
+    found(first + lane, row[lane], col[lane], range[lane]);
+  }
+}
+
 #endif  // ELO_PIXEL_LANES
 
 // The pixels of items [first, first + kPixelLanes) below `count`: `point(i, p)` gives item i's point p
@@ -113,9 +147,7 @@ void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t c
       usable & pixelsOfLanes(projection, _mm256_setr_ps(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]),
                              _mm256_setr_ps(y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7]),
                              _mm256_setr_ps(z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]), row, col, range);
-  for (int lane = 0; lane < kPixelLanes; ++lane) {
-    if (accepted & (1u << lane)) found(first + lane, row[lane], col[lane], range[lane]);
-  }
+  foundLanes(first, accepted, row, col, range, found);
 #else
   for (size_t i = first; i < first + kPixelLanes && i < count; ++i) {
     Float3 p;
@@ -124,6 +156,32 @@ void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t c
     if (point(i, p) && projection.pixelOf(p, row, col)) found(i, row, col, norm(p));
   }
 #endif
+}
+
+// pixelsOfGroup() for the finite points among `count` whose coordinates `xyz` holds (x, y, z after one
+// another, as a vector of Vec3f lays them out), taken as they are: a whole group's lanes come from
+// loadPointLanes().
+template <typename Found>
+void pixelsOfPoints(const SphericalProjection& projection, const float* xyz, size_t first, size_t count,
+                    const Found& found) {
+#ifdef ELO_PIXEL_LANES
+  if (first + kPixelLanes <= count) {
+    __m256 x, y, z;
+    loadPointLanes(xyz + 3 * first, x, y, z);
+    float range[kPixelLanes];
+    int row[kPixelLanes], col[kPixelLanes];
+    const unsigned accepted = finiteLanes(x, y, z) & pixelsOfLanes(projection, x, y, z, row, col, range);
+    foundLanes(first, accepted, row, col, range, found);
+    return;
+  }
+#endif
+  pixelsOfGroup(
+      projection, first, count,
+      [&](size_t i, Float3& p) {
+        p = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+        return isFinite(p);
+      },
+      found);
 }
 
 }  // namespace elo::cpu
