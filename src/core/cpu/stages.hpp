@@ -19,8 +19,9 @@ namespace elo::cpu {
 
 // projection.cpp: the closest point of the cloud per pixel, every point deskewed by `deskew` first;
 // `ring_rows` maps a driver's ring index to its row (empty: rows from the elevation). `winners` must be
-// empty, as resize() leaves it, and is left empty. `placed` is scratch: each cloud point as placed.
-// Returns the number of occupied pixels.
+// empty, as resize() leaves it, and is left empty. `placed` is scratch: each cloud point as placed, where
+// the points are corrected or deskewed (otherwise the winners are read from the cloud itself). Returns
+// the number of occupied pixels.
 size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const SphericalProjection& projection,
                     const std::vector<int>& ring_rows, const SweepDeskew& deskew, float stamp, ClosestWins& winners,
                     std::vector<ScanPoint>& placed, ScanImage& scan);
