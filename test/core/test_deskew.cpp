@@ -2,11 +2,15 @@
 // projection of a sweep taken while moving, bad per-point times, and the odometry on such sweeps.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <limits>
+#include <random>
+#include <string>
 
 #include "analytic_scene.hpp"
 #include "core/common/deskew.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/cpu/deskew_lanes.hpp"
 #include "core/cpu/stages.hpp"
 #include "elo/deskew.hpp"
 #include "elo/odometry.hpp"
@@ -144,6 +148,78 @@ TEST(Deskew, TheCpuPassOverPixelsGivesEachPixelThePerPixelMath) {
     }
   }
 }
+
+#ifdef ELO_PIXEL_LANES
+// The projection places a cloud's points 8 at a time where all of a group's turn little
+// (deskew_lanes.hpp): each lane gets scanPointVertex()'s measured point, time and vertex, bit for bit,
+// and the lanes with a point are the points scanPointVertex() places (finite, with a time of the sweep).
+// Times from a field (some outside the sweep, some NaN) and from the azimuth, with and without KITTI's
+// elevation correction, at rest, driving, and in a sharp turn, which sends the groups that hold a point
+// more than 40 ms from the reference back to placing point by point.
+TEST(Deskew, PointsPlacedEightAtOnceAreThoseOfTheSharedMath) {
+  constexpr size_t kGroups = 2000;
+  constexpr size_t kPoints = kGroups * cpu::kPixelLanes;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> across(-60.0f, 60.0f);
+  std::uniform_real_distribution<float> height(-3.0f, 3.0f);
+  std::uniform_real_distribution<float> within_sweep(-0.06f, 0.06f);
+  std::vector<float> xyz;
+  std::vector<float> times;
+  for (size_t i = 0; i < kPoints; ++i) {
+    xyz.insert(xyz.end(), {i % 97 == 5 ? NAN : across(random), across(random), height(random)});
+    times.push_back(i % 89 == 7 ? 5.0f : i % 101 == 3 ? NAN : within_sweep(random));
+  }
+  Vector6d sharp_turn;  // turning little only within 40 ms of the reference
+  sharp_turn << 8.0, 0.0, 0.0, 0.0, 0.0, 0.8;
+  SensorConfig sensor;
+  for (const double correction_deg : {0.0, 0.195}) {
+    sensor.elevation_correction_deg = correction_deg;
+    const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
+    for (const TimeSource source : {TimeSource::field, TimeSource::azimuth}) {
+      for (const Vector6d& twist : {Vector6d::Zero().eval(), drivingVelocity(), sharp_turn}) {
+        const bool turns_sharply = twist == sharp_turn;
+        SCOPED_TRACE(std::string(source == TimeSource::field ? "field" : "azimuth") + " times, correction " +
+                     std::to_string(correction_deg) + (turns_sharply ? ", sharp turn" : twist.isZero() ? ", at rest" : ""));
+        const SweepDeskew deskew{SweepTiming::fromConfig(sensor, source),
+                                 source == TimeSource::field ? times.data() : nullptr, toSweepVelocity(twist)};
+        std::vector<ScanPoint> placed(kPoints);
+        size_t groups_in_lanes = 0;
+        size_t points_placed = 0;
+        for (size_t first = 0; first < kPoints; first += cpu::kPixelLanes) {
+          cpu::PlacedLanes lanes;
+          if (!cpu::placeLanes(correction, deskew, xyz.data(), first, placed.data(), lanes)) continue;
+          ++groups_in_lanes;
+          float vertex[3][cpu::kPixelLanes];
+          _mm256_storeu_ps(vertex[0], lanes.x);
+          _mm256_storeu_ps(vertex[1], lanes.y);
+          _mm256_storeu_ps(vertex[2], lanes.z);
+          for (int lane = 0; lane < cpu::kPixelLanes; ++lane) {
+            const size_t i = first + lane;
+            const Float3 raw{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+            ScanPoint expected;
+            const bool has_point = isFinite(raw) && scanPointVertex(correction, deskew, static_cast<int>(i), raw, expected);
+            ASSERT_EQ((lanes.usable >> lane) & 1u, has_point ? 1u : 0u) << "point " << i;
+            if (!has_point) continue;
+            ++points_placed;
+            const Float3 lane_vertex{vertex[0][lane], vertex[1][lane], vertex[2][lane]};
+            ASSERT_EQ(std::memcmp(&placed[i].measured, &expected.measured, sizeof(Float3)), 0) << "point " << i;
+            ASSERT_EQ(std::memcmp(&placed[i].vertex, &expected.vertex, sizeof(Float3)), 0) << "point " << i;
+            ASSERT_EQ(std::memcmp(&lane_vertex, &expected.vertex, sizeof(Float3)), 0) << "point " << i;
+            ASSERT_EQ(std::memcmp(&placed[i].time, &expected.time, sizeof(float)), 0) << "point " << i;
+          }
+        }
+        if (turns_sharply) {
+          EXPECT_GT(groups_in_lanes, 0u);
+          EXPECT_LT(groups_in_lanes, kGroups / 2);
+        } else {
+          EXPECT_EQ(groups_in_lanes, kGroups);
+        }
+        EXPECT_GT(points_placed, groups_in_lanes * cpu::kPixelLanes * 9 / 10);
+      }
+    }
+  }
+}
+#endif
 
 class MovingSweep : public ::testing::TestWithParam<TimeSource> {
  protected:

@@ -4,6 +4,7 @@
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/scan_projection.hpp"
+#include "core/cpu/deskew_lanes.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
@@ -46,10 +47,21 @@ struct CorrectedPoints {
   ScanPoint* kept;
   bool timed;  // the points have times, so the scan keeps them and its measured points (ScanImage)
 
+  // A whole group is placed in lanes where it can be (placeLanes()), otherwise point by point.
   template <typename Found>
   void pixelsOfGroup(const SphericalProjection& projection, size_t group, const Found& found) const {
-    cpu::pixelsOfGroup(projection, group * kPixelLanes, count, [&](size_t i, Float3& vertex) { return place(i, vertex); },
-                       found);
+    const size_t first = group * kPixelLanes;
+#ifdef ELO_PIXEL_LANES
+    PlacedLanes lanes;
+    if (first + kPixelLanes <= count && placeLanes(correction, deskew, points->data(), first, kept, lanes)) {
+      float range[kPixelLanes];
+      int row[kPixelLanes], col[kPixelLanes];
+      const unsigned accepted = lanes.usable & pixelsOfLanes(projection, lanes.x, lanes.y, lanes.z, row, col, range);
+      foundLanes(first, accepted, row, col, range, found);
+      return;
+    }
+#endif
+    cpu::pixelsOfGroup(projection, first, count, [&](size_t i, Float3& vertex) { return place(i, vertex); }, found);
   }
   void take(uint32_t i, Vec3f& vertex, Vec3f& measured, float& time) const {
     vertex = toVec3f(kept[i].vertex);
