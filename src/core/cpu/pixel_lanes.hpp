@@ -112,11 +112,15 @@ inline unsigned finiteLanes(__m256 x, __m256 y, __m256 z) {
   return static_cast<unsigned>(_mm256_movemask_ps(finite));
 }
 
-// found(first + k, ...) for each lane k set in `accepted`, in order.
+// found(first + k, row, col, range) for each lane k of `usable` whose point (x[k], y[k], z[k])
+// pixelOf() accepts (pixelsOfLanes()), in order.
 template <typename Found>
-void foundLanes(size_t first, unsigned accepted, const int* row, const int* col, const float* range,
-                const Found& found) {
-  for (; accepted != 0; accepted &= accepted - 1) {
+void foundPixelsOfLanes(const SphericalProjection& projection, size_t first, unsigned usable, __m256 x, __m256 y,
+                        __m256 z, const Found& found) {
+  float range[kPixelLanes];
+  int row[kPixelLanes], col[kPixelLanes];
+  for (unsigned accepted = usable & pixelsOfLanes(projection, x, y, z, row, col, range); accepted != 0;
+       accepted &= accepted - 1) {
     const int lane = __builtin_ctz(accepted);
     found(first + lane, row[lane], col[lane], range[lane]);
   }
@@ -130,8 +134,7 @@ template <typename Point, typename Found>
 void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t count, const Point& point,
                    const Found& found) {
 #ifdef ELO_PIXEL_LANES
-  float x[kPixelLanes], y[kPixelLanes], z[kPixelLanes], range[kPixelLanes];
-  int row[kPixelLanes], col[kPixelLanes];
+  float x[kPixelLanes], y[kPixelLanes], z[kPixelLanes];
   unsigned usable = 0;
   for (int lane = 0; lane < kPixelLanes; ++lane) {
     const size_t i = first + lane;
@@ -143,11 +146,9 @@ void pixelsOfGroup(const SphericalProjection& projection, size_t first, size_t c
     z[lane] = has_point ? p.z : 0.0f;
   }
   // Lanes set from registers: a vector load of the 8 floats just stored one by one would wait for them.
-  const unsigned accepted =
-      usable & pixelsOfLanes(projection, _mm256_setr_ps(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]),
-                             _mm256_setr_ps(y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7]),
-                             _mm256_setr_ps(z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]), row, col, range);
-  foundLanes(first, accepted, row, col, range, found);
+  foundPixelsOfLanes(projection, first, usable, _mm256_setr_ps(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]),
+                     _mm256_setr_ps(y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7]),
+                     _mm256_setr_ps(z[0], z[1], z[2], z[3], z[4], z[5], z[6], z[7]), found);
 #else
   for (size_t i = first; i < first + kPixelLanes && i < count; ++i) {
     Float3 p;
@@ -168,10 +169,7 @@ void pixelsOfPoints(const SphericalProjection& projection, const float* xyz, siz
   if (first + kPixelLanes <= count) {
     __m256 x, y, z;
     loadPointLanes(xyz + 3 * first, x, y, z);
-    float range[kPixelLanes];
-    int row[kPixelLanes], col[kPixelLanes];
-    const unsigned accepted = finiteLanes(x, y, z) & pixelsOfLanes(projection, x, y, z, row, col, range);
-    foundLanes(first, accepted, row, col, range, found);
+    foundPixelsOfLanes(projection, first, finiteLanes(x, y, z), x, y, z, found);
     return;
   }
 #endif

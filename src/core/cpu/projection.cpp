@@ -54,10 +54,7 @@ struct CorrectedPoints {
 #ifdef ELO_PIXEL_LANES
     PlacedLanes lanes;
     if (first + kPixelLanes <= count && placeLanes(correction, deskew, points->data(), first, kept, lanes)) {
-      float range[kPixelLanes];
-      int row[kPixelLanes], col[kPixelLanes];
-      const unsigned accepted = lanes.usable & pixelsOfLanes(projection, lanes.x, lanes.y, lanes.z, row, col, range);
-      foundLanes(first, accepted, row, col, range, found);
+      foundPixelsOfLanes(projection, first, lanes.usable, lanes.x, lanes.y, lanes.z, found);
       return;
     }
 #endif
