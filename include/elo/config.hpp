@@ -24,8 +24,9 @@ enum class BackendKind { cpu, cuda };
 // sensor's rotation (sensor.rotation_rate_hz, sensor.clockwise, sensor.sweep_start_azimuth_deg).
 enum class TimeSource { none, field, azimuth };
 // Which beam a driver's `ring` 0 is: velodyne_pointcloud counts rings up from the lowest beam, ouster_ros
-// down from the highest.
-enum class RingZero { bottom, top };
+// down from the highest; `table`: ring k is entry k of sensor.beam_elevations_deg, for a driver that
+// numbers its rings in an order that is not the beams' (Hesai's QT128: its correction file's channels).
+enum class RingZero { bottom, top, table };
 
 // Sec. III-B.1, Eq. 3-4: the sensor and its spherical range image.
 struct SensorConfig {
@@ -41,8 +42,8 @@ struct SensorConfig {
   // Rotates every point's elevation up by this angle. KITTI's HDL-64E intrinsics bend the scan; the
   // paper (after IMLS-SLAM) corrects by 0.195 deg. Zero for any other data.
   double elevation_correction_deg = 0.0;
-  // Nominal elevation of each beam, top to bottom; the simulator fires these. Empty means `beam_count`
-  // beams spread evenly over the field of view.
+  // Nominal elevation of each beam, top to bottom (with ring_zero table: in the driver's ring order); the
+  // simulator fires these. Empty means `beam_count` beams spread evenly over the field of view.
   std::vector<double> beam_elevations_deg = hdl64BeamElevations();
   int beam_count = 64;
   // How the `ring` field numbers the beams (ringElevations()); the simulator numbers them the same way.

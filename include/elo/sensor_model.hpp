@@ -16,7 +16,8 @@ inline Vec3f correctElevation(const Vec3f& p, float cos_angle, float sin_angle) 
   return Vec3f(corrected.x, corrected.y, corrected.z);
 }
 
-// Nominal elevation (rad) of each beam, top to bottom, from the config's table or an even spread.
+// Nominal elevation (rad) of each beam, from the config's table (top to bottom, or in ring order with
+// sensor.ring_zero table) or an even spread, top to bottom.
 std::vector<float> beamElevations(const SensorConfig& sensor);
 // The same, indexed by the ring a driver gives each beam (sensor.ring_zero).
 std::vector<float> ringElevations(const SensorConfig& sensor);

@@ -1,5 +1,6 @@
 #include "elo/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -108,11 +109,13 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("sensor.elevation_correction_deg", s.elevation_correction_deg,
            "raise every point's elevation by this angle; 0.195 for KITTI (Sec. IV-A)"),
       bindField("sensor.beam_elevations_deg", s.beam_elevations_deg,
-           "nominal beam elevations top to bottom, deg; empty = beam_count beams spread evenly"),
+           "nominal beam elevations top to bottom (ring_zero table: in ring order), deg; empty = beam_count "
+           "beams spread evenly"),
       bindField("sensor.beam_count", s.beam_count, "number of beams"),
-      bindChoice("sensor.ring_zero", s.ring_zero, {{RingZero::bottom, "bottom"}, {RingZero::top, "top"}},
-                 "the beam a cloud's ring 0 is: bottom (velodyne_pointcloud counts up from the lowest beam) or top "
-                 "(ouster_ros counts down from the highest)"),
+      bindChoice("sensor.ring_zero", s.ring_zero,
+                 {{RingZero::bottom, "bottom"}, {RingZero::top, "top"}, {RingZero::table, "table"}},
+                 "the beam a cloud's ring 0 is: bottom (velodyne_pointcloud counts up from the lowest beam), top "
+                 "(ouster_ros counts down from the highest) or table (ring k is beam_elevations_deg's entry k)"),
       bindField("sensor.azimuth_steps", s.azimuth_steps, "firings per revolution (simulator)"),
       bindField("sensor.rotation_rate_hz", s.rotation_rate_hz,
                 "revolutions per second (simulator, azimuth times, window of per-point times)"),
@@ -205,6 +208,12 @@ void validate(const Config& c) {
   require(s.beam_count > 0, "sensor.beam_count", "must be positive");
   require(s.beam_elevations_deg.empty() || static_cast<int>(s.beam_elevations_deg.size()) == s.beam_count,
           "sensor.beam_elevations_deg", "must list sensor.beam_count elevations (or none)");
+  // Rings counted from the top or the bottom name the right beams only if the table runs top to bottom.
+  require(s.ring_zero == RingZero::table ||
+              std::is_sorted(s.beam_elevations_deg.rbegin(), s.beam_elevations_deg.rend()),
+          "sensor.beam_elevations_deg", "must run from the top beam down (or set sensor.ring_zero: table)");
+  require(s.ring_zero != RingZero::table || !s.beam_elevations_deg.empty(), "sensor.ring_zero",
+          "table needs sensor.beam_elevations_deg in the driver's ring order");
   require(s.azimuth_steps > 0, "sensor.azimuth_steps", "must be positive");
   require(s.rotation_rate_hz > 0.0, "sensor.rotation_rate_hz", "must be positive");
   require(s.range_noise_stddev >= 0.0, "sensor.range_noise_stddev", "must not be negative");

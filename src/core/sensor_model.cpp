@@ -56,7 +56,7 @@ int ringOfBeam(const SensorConfig& sensor, int beam) {
   // Counted without building the table: the simulator asks for every point.
   const int beams =
       sensor.beam_elevations_deg.empty() ? sensor.beam_count : static_cast<int>(sensor.beam_elevations_deg.size());
-  return sensor.ring_zero == RingZero::top ? beam : beams - 1 - beam;
+  return sensor.ring_zero == RingZero::bottom ? beams - 1 - beam : beam;
 }
 
 std::vector<float> ringElevations(const SensorConfig& sensor) {

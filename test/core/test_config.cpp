@@ -3,6 +3,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "elo/config.hpp"
 
@@ -95,6 +96,13 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   config = Config();
   config.sensor.beam_count = 32;
   EXPECT_NE(message_of(config).find("sensor.beam_elevations_deg"), std::string::npos);
+  config = Config();
+  std::swap(config.sensor.beam_elevations_deg[3], config.sensor.beam_elevations_deg[4]);  // rings would miss
+  EXPECT_NE(message_of(config).find("must run from the top beam down"), std::string::npos);
+  config.sensor.ring_zero = RingZero::table;  // the driver's own order
+  EXPECT_EQ(message_of(config), "accepted");
+  config.sensor.beam_elevations_deg.clear();
+  EXPECT_NE(message_of(config).find("sensor.ring_zero"), std::string::npos);
   config = Config();
   config.bev.cell_size = 0.001;
   EXPECT_NE(message_of(config).find("bev.cell_size"), std::string::npos);

@@ -67,6 +67,21 @@ TEST(SensorFit, CountsPointsFarFromTheirRingsBeam) {
   EXPECT_EQ(checkSensorFit(cloudOf(points), hdl64, 1).off_beam, 0u);  // half a degree off: calibration
 }
 
+// A driver that numbers its rings in neither elevation order (Hesai's QT128: its correction file's
+// channels) is described by the table in that order: ring k is entry k, and the simulator fires it so.
+TEST(SensorFit, RingZeroTableTakesTheTablesOrder) {
+  SensorConfig sensor;
+  sensor.ring_zero = RingZero::table;
+  sensor.beam_count = 4;
+  sensor.beam_elevations_deg = {-20.0, -10.0, 0.0, -15.0};
+  EXPECT_EQ(ringOfBeam(sensor, 3), 3);
+  std::vector<std::pair<double, uint16_t>> points;
+  for (uint16_t ring = 0; ring < 4; ++ring) points.push_back({sensor.beam_elevations_deg[ring], ring});
+  EXPECT_EQ(checkSensorFit(cloudOf(points), sensor, 1).misplaced(), 0u);
+  sensor.ring_zero = RingZero::bottom;
+  EXPECT_EQ(checkSensorFit(cloudOf(points), sensor, 1).off_beam, 4u);
+}
+
 // Close in, where the lasers' offsets on the head bend elevations, a ring is not checked against its beam.
 TEST(SensorFit, LeavesRingsOfClosePointsUnchecked) {
   PointCloud cloud = cloudOf({{-10.0, 0}});

@@ -8,7 +8,8 @@
 
 namespace elo::sim {
 
-std::vector<std::string> sensorNames();  // hdl64, vlp16, vlp32, os1-64, os1-128
+// The supported sensors of the README's table: config/NAME.yaml for each.
+std::vector<std::string> sensorNames();
 
 // Overrides `config` with config/NAME.yaml. Throws std::invalid_argument for an unknown name, and
 // ConfigError or IoError for a file that cannot be read.
