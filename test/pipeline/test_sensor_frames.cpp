@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <ostream>
 #include <set>
 #include <string>
 #include <vector>
@@ -28,6 +29,9 @@ struct RealFrame {
   std::string config;  // config/NAME.yaml
   std::string file;    // in kFrames
 };
+
+// gtest names a test by this rather than by its bytes.
+void PrintTo(const RealFrame& frame, std::ostream* out) { *out << frame.file << " under config/" << frame.config << ".yaml"; }
 
 std::string frameName(const testing::TestParamInfo<RealFrame>& info) {
   std::string name = info.param.config;
