@@ -34,7 +34,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames two" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 0" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight" + out), 2);                    // no frame count
-  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --sensor hdl32" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --sensor hdl128" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --dropout 1.5" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --deskewed yes" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --deskewed 0 --time-convention gps" + out), 2);
