@@ -1,0 +1,74 @@
+#include "ros1_bag.hpp"
+
+#include <ros/message_traits.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include <algorithm>
+#include <map>
+
+#include "cloud_conversion.hpp"
+
+namespace elo_ros {
+namespace {
+
+using CloudType = ros::message_traits::DataType<sensor_msgs::PointCloud2>;
+
+std::vector<elo::BagTopic> topicsOf(const rosbag::Bag& bag) {
+  std::map<std::string, elo::BagTopic> topics;
+  for (const rosbag::ConnectionInfo* connection : rosbag::View(bag).getConnections()) {
+    topics[connection->topic] = {connection->topic, connection->datatype, 0};
+  }
+  for (auto& [name, topic] : topics) topic.messages = rosbag::View(bag, rosbag::TopicQuery(name)).size();
+  std::vector<elo::BagTopic> list;
+  for (const auto& [name, topic] : topics) list.push_back(topic);
+  return list;
+}
+
+}  // namespace
+
+Ros1Bag::Ros1Bag(const std::string& path, const std::string& topic) : path_(path) {
+  try {
+    bag_.open(path_, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& error) {
+    throw elo::IoError("cannot read bag '" + path_ + "': " + error.what() +
+                       " (a bag cut short has lost its index: `rosbag reindex` restores what it holds)");
+  }
+  topic_ = elo::chooseCloudTopic("bag '" + path_ + "'", topicsOf(bag_), CloudType::value(), topic);
+  listMessages();
+  if (messages_.empty()) throw elo::IoError(describe() + " holds no message");
+}
+
+// Reads every message of the topic once for its header stamp (a bag records messages in the order they
+// arrived, which need not be their stamps' order) and sorts them by it.
+void Ros1Bag::listMessages() {
+  view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
+  for (const rosbag::MessageInstance& instance : *view_) {
+    double stamp = instance.getTime().toSec();
+    try {
+      if (const auto cloud = instance.instantiate<sensor_msgs::PointCloud2>()) stamp = cloud->header.stamp.toSec();
+    } catch (const std::exception&) {
+      // An unreadable message keeps its recording time; reading it says what is wrong.
+    }
+    messages_.push_back({instances_.size(), stamp});
+    instances_.push_back(instance);
+  }
+  std::stable_sort(messages_.begin(), messages_.end(),
+                   [](const Message& a, const Message& b) { return a.stamp < b.stamp; });
+}
+
+elo::LoadedScan Ros1Bag::read(size_t index) const {
+  const Message& message = messages_.at(index);
+  const std::string where = describe() + ", message " + std::to_string(message.position);
+  sensor_msgs::PointCloud2::ConstPtr cloud;
+  try {
+    cloud = instances_[message.position].instantiate<sensor_msgs::PointCloud2>();
+  } catch (const std::exception& error) {
+    throw elo::UnusableScan("message unreadable", where + ": " + error.what());
+  }
+  if (!cloud) throw elo::UnusableScan("message unreadable", where + ": not a " + CloudType::value() + " message");
+  ConvertedCloud converted = fromPointCloud2(*cloud);
+  if (!converted.usable()) throw elo::UnusableScan(elo::describe(converted.problem), where + ": " + converted.detail);
+  return {std::move(converted.cloud), converted.non_finite_points, converted.time_problem};
+}
+
+}  // namespace elo_ros
