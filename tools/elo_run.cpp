@@ -9,8 +9,8 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <numeric>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <string>
