@@ -55,6 +55,9 @@ class Ros2Bag::File {
       sqlite3_close(database_);
       throw IoError("cannot open '" + path_ + "': " + reason);
     }
+    // SQLite refuses a whole file that is shorter than its header says (a copy cut short) unless the
+    // schema is writable; then it reads it up to the cut. The connection stays read-only.
+    sqlite3_exec(database_, "PRAGMA writable_schema=ON", nullptr, nullptr, nullptr);
   }
   ~File() { sqlite3_close(database_); }
   File(const File&) = delete;
@@ -149,16 +152,17 @@ Ros2Bag::Ros2Bag(const std::string& directory, const std::string& topic) : direc
 Ros2Bag::~Ros2Bag() = default;
 
 // Lists the topic's messages file by file in row order, each with the header stamp read from its first
-// bytes (incremental blob I/O reads no further), then sorts them by stamp. Row order lets a damaged file
-// give every message before the damage.
+// bytes (incremental blob I/O reads no further), then sorts them by stamp. In row order, a damaged file
+// gives the messages SQLite reaches before the damage.
 void Ros2Bag::listMessages() {
   for (size_t index = 0; index < files_.size(); ++index) {
     const File& file = *files_[index];
-    Statement rows(file.database(),
-                   "SELECT messages.id, messages.timestamp FROM messages JOIN topics ON messages.topic_id = topics.id "
-                   "WHERE topics.name = ? ORDER BY messages.id",
-                   file.path());
-    sqlite3_bind_text(rows.get(), 1, topic_.c_str(), -1, SQLITE_TRANSIENT);
+    const std::vector<File::Topic> topics = file.topics();
+    const auto topic = std::find_if(topics.begin(), topics.end(), [&](const File::Topic& t) { return t.name == topic_; });
+    if (topic == topics.end()) continue;  // recorded in another file of the bag
+    // In row order, which SQLite reads as the table is stored, one row at a time.
+    Statement rows(file.database(), "SELECT id, timestamp FROM messages WHERE topic_id = ? ORDER BY id", file.path());
+    sqlite3_bind_int64(rows.get(), 1, topic->id);
     int status;
     while ((status = sqlite3_step(rows.get())) == SQLITE_ROW) {
       const int64_t row = sqlite3_column_int64(rows.get(), 0);
@@ -177,8 +181,8 @@ void Ros2Bag::listMessages() {
       messages_.push_back({index, row, stamp});
     }
     if (status != SQLITE_DONE) {
-      warning_ += (warning_.empty() ? "" : "; ") + std::string("'") + file.path() + "' is damaged (" +
-                  sqlite3_errmsg(file.database()) + "): read up to it";
+      warning_ += (warning_.empty() ? "" : "; ") + std::string("'") + file.path() + "' is damaged (SQLite: " +
+                  sqlite3_errmsg(file.database()) + "; a copy cut short?): its messages past the damage are left out";
     }
   }
   std::stable_sort(messages_.begin(), messages_.end(),

@@ -23,7 +23,8 @@ class Ros2Bag : public ScanSource {
   // Opens every .db3 file of `directory` and lists the clouds of `topic` (empty: the bag's only
   // PointCloud2 topic) in header-stamp order. Throws IoError for MCAP storage, no .db3 file, a file SQLite
   // cannot open, no such topic (the message lists the bag's topics) or no message on it. A file damaged
-  // part-way (a copy cut short) is read up to the damage, and warning() says so.
+  // part-way (a copy cut short) gives the messages SQLite reaches before the damage, and warning() says
+  // so; where its message table cannot be followed at all, none, and the error says why.
   Ros2Bag(const std::string& directory, const std::string& topic);
   ~Ros2Bag() override;
 
