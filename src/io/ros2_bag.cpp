@@ -59,7 +59,10 @@ class Ros2Bag::File {
     // schema is writable; then it reads it up to the cut. The connection stays read-only.
     sqlite3_exec(database_, "PRAGMA writable_schema=ON", nullptr, nullptr, nullptr);
   }
-  ~File() { sqlite3_close(database_); }
+  ~File() {
+    sqlite3_blob_close(blob_);
+    sqlite3_close(database_);
+  }
   File(const File&) = delete;
   File& operator=(const File&) = delete;
 
@@ -90,18 +93,20 @@ class Ros2Bag::File {
     return static_cast<size_t>(sqlite3_column_int64(statement.get(), 0));
   }
 
-  // The message's bytes; empty, with `error` set, when SQLite cannot read them.
+  // The message's bytes, read with incremental blob I/O straight into the buffer (one copy); empty, with
+  // `error` set, when SQLite cannot read them.
   std::vector<uint8_t> message(int64_t row, std::string& error) const {
-    if (!read_) read_ = std::make_unique<Statement>(database_, "SELECT data FROM messages WHERE id = ?", path_);
-    sqlite3_stmt* statement = read_->get();
-    sqlite3_reset(statement);
-    sqlite3_bind_int64(statement, 1, row);
-    if (sqlite3_step(statement) != SQLITE_ROW) {
-      error = sqlite3_errmsg(database_);
-      return {};
+    const int opened = blob_ == nullptr ? sqlite3_blob_open(database_, "main", "messages", "data", row, 0, &blob_)
+                                        : sqlite3_blob_reopen(blob_, row);
+    std::vector<uint8_t> bytes;
+    if (opened == SQLITE_OK) {
+      bytes.resize(static_cast<size_t>(sqlite3_blob_bytes(blob_)));
+      if (sqlite3_blob_read(blob_, bytes.data(), static_cast<int>(bytes.size()), 0) == SQLITE_OK) return bytes;
     }
-    const auto* bytes = static_cast<const uint8_t*>(sqlite3_column_blob(statement, 0));
-    return std::vector<uint8_t>(bytes, bytes + sqlite3_column_bytes(statement, 0));
+    error = sqlite3_errmsg(database_);
+    sqlite3_blob_close(blob_);  // a failed reopen leaves the handle unusable
+    blob_ = nullptr;
+    return {};
   }
 
  private:
@@ -112,7 +117,7 @@ class Ros2Bag::File {
 
   std::string path_;
   sqlite3* database_ = nullptr;
-  mutable std::unique_ptr<Statement> read_;
+  mutable sqlite3_blob* blob_ = nullptr;  // the last message read, reopened on the next
 };
 
 bool isRos2Bag(const std::string& path) {

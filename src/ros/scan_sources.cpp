@@ -15,6 +15,9 @@ std::unique_ptr<elo::ScanSource> openScanSource(const std::string& input, const 
                        "`ros2 bag convert` (storage_id: sqlite3)");
   }
   if (extension == ".bag") return std::make_unique<Ros1Bag>(input, topic);
+  if (extension == ".db3") {  // a file of a ROS 2 bag: the bag is its directory
+    return std::make_unique<elo::Ros2Bag>(std::filesystem::absolute(input).parent_path().string(), topic);
+  }
   if (elo::isRos2Bag(input)) return std::make_unique<elo::Ros2Bag>(input, topic);
   if (!topic.empty()) throw elo::IoError("--topic names a bag topic, but '" + input + "' is not a bag");
   return std::make_unique<elo::Sequence>(input);

@@ -1,5 +1,5 @@
-// Opens what elo_run's --input names: a ROS 1 bag (*.bag), a ROS 2 bag (a directory with metadata.yaml),
-// or a sequence directory. Here, beside the ROS 1 reader, because only the ROS layer may read ROS 1 bags.
+// Opens what elo_run's --input names: a ROS 1 bag (*.bag), a ROS 2 bag (a directory with metadata.yaml,
+// or one of its .db3 files), or a sequence directory. Here, beside the ROS 1 reader, because only the ROS layer may read ROS 1 bags.
 #pragma once
 
 #include <memory>
