@@ -46,7 +46,7 @@ class Statement {
 
 }  // namespace
 
-// One .db3 file, open read-only for the whole run, with the statement that reads a message.
+// One .db3 file, open read-only for the whole run.
 class Ros2Bag::File {
  public:
   explicit File(std::string path) : path_(std::move(path)) {
