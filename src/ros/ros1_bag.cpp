@@ -81,8 +81,8 @@ Ros1Bag::Ros1Bag(const std::string& path, const std::string& topic) : path_(path
 // Reads the header stamp of every message of the topic (a bag records messages in the order they arrived,
 // which need not be their stamps' order) and sorts them by it.
 void Ros1Bag::listMessages() {
-  view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
-  for (const rosbag::MessageInstance& instance : *view_) {
+  // A MessageInstance refers to the bag, not to the view: the copies stay valid while bag_ is open.
+  for (const rosbag::MessageInstance& instance : rosbag::View(bag_, rosbag::TopicQuery(topic_))) {
     double stamp = instance.getTime().toSec();
     try {
       if (const auto cloud = instance.instantiate<CloudHeader>()) stamp = cloud->header.stamp.toSec();

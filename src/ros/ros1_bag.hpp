@@ -7,7 +7,6 @@
 #include <rosbag/message_instance.h>
 #include <rosbag/view.h>
 
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -40,7 +39,6 @@ class Ros1Bag : public elo::ScanSource {
   std::string path_;
   std::string topic_;
   rosbag::Bag bag_;
-  std::unique_ptr<rosbag::View> view_;
   std::vector<rosbag::MessageInstance> instances_;  // valid while bag_ is open
   std::vector<Message> messages_;                  // in stamp order
 };
