@@ -20,7 +20,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libroscpp-dev libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev \
   libpcl-ros-dev libpcl-conversions-dev librostest-dev python3-rostest libsensor-msgs-dev \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
-  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz
+  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
 
 .PHONY: deps build test test-long test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
 
@@ -79,7 +79,7 @@ test-tsan: deps
 # says where the corpus grows and where a crasher lands.
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := fuzz_cloud_conversion fuzz_kitti_bin fuzz_pcd fuzz_kitti_text fuzz_config_yaml
+FUZZ_TARGETS := fuzz_cloud_conversion fuzz_cdr_point_cloud2 fuzz_kitti_bin fuzz_pcd fuzz_kitti_text fuzz_config_yaml
 fuzz: DEB_PACKAGES += clang libclang-rt-14-dev
 fuzz: deps
 	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DELO_FUZZ=ON \

@@ -1,5 +1,5 @@
-// elo_run: runs the odometry over a sequence on disk (KITTI layout or a directory of PCD/BIN scans) and
-// writes the trajectory. Thin: parse flags, load scans, call elo::Odometry, report.
+// elo_run: runs the odometry over a sequence on disk (KITTI layout or a directory of PCD/BIN scans) or a
+// ROS 1 or ROS 2 bag, and writes the trajectory. Thin: parse flags, read scans, call elo::Odometry, report.
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -9,30 +9,36 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
-#include "elo/io/sequence.hpp"
+#include "elo/io/scan_source.hpp"
 #include "elo/odometry.hpp"
 #include "command_line.hpp"
+#include "scan_sources.hpp"
 
 namespace {
 
-constexpr char kUsage[] = R"(usage: elo_run --input DIR --output POSES [options]
+constexpr char kUsage[] = R"(usage: elo_run --input DIR|BAG --output POSES [options]
 
 Runs ELO odometry over DIR (KITTI layout: DIR/velodyne/*.bin with optional times.txt and calib.txt;
-or a directory of .pcd / .bin scans) and writes one KITTI pose line per scan (sensor frame, scan 0 at
-the origin). With DIR/calib.txt it also writes the camera-frame trajectory the KITTI devkit scores.
-A scan that cannot be read (missing, truncated, malformed) is skipped and counted like a scan the
-odometry cannot use: its pose line repeats the last pose, and the summary says how many and why. A run
-that fails part-way still writes the poses of the scans before the failure.
+or a directory of .pcd / .bin scans) or over the sensor_msgs/PointCloud2 clouds of a bag (a ROS 1
+DRIVE.bag, or a ROS 2 bag directory: metadata.yaml and *.db3) in header-stamp order, and writes one
+KITTI pose line per scan (sensor frame, scan 0 at the origin). With DIR/calib.txt it also writes the
+camera-frame trajectory the KITTI devkit scores. A scan that cannot be read (missing, truncated,
+malformed file or message) or used is skipped and counted like a scan the odometry cannot use: its pose
+line repeats the last pose, and the summary says how many and why. A run that fails part-way still
+writes the poses of the scans before the failure.
 
 options:
+  --topic NAME         the bag's cloud topic (default: its only PointCloud2 topic)
   --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config)
   --mode f2m|f2f       frame-to-model (default) or frame-to-frame
   --threads N          CPU threads (default: all)
@@ -44,7 +50,8 @@ options:
   --reverse            play the scans last to first, the route driven backwards (stamps mirrored
                        so time still advances); elo_eval --reverse compares it with a forward run
   --timing CSV         per-frame stage times, iterations, deskew rounds, inlier counts and degeneracy
-  --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw)
+  --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw; a bag's
+                       stamps are its clouds' header stamps)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
   --strict             stop at the first scan that cannot be read and exit 1 (after writing the
                        poses of the scans before it), instead of skipping it
@@ -57,6 +64,7 @@ options:
 
 struct Options {
   std::string input;
+  std::string topic;
   std::string output;
   std::string config_file;
   std::string timing_csv;
@@ -80,6 +88,8 @@ Options parseArguments(int argc, char** argv) {
   while (arguments.next()) {
     if (arguments.is("--input")) {
       options.input = arguments.value();
+    } else if (arguments.is("--topic")) {
+      options.topic = arguments.value();
     } else if (arguments.is("--output")) {
       options.output = arguments.value();
     } else if (arguments.is("--config")) {
@@ -164,22 +174,19 @@ StageSummary summarise(std::vector<double> values) {
   return summary;
 }
 
-// A scan read from disk, or why it could not be read: the counted reason and the reader's message (a
-// missing, truncated or malformed file).
+// A scan that was read, or why it could not be read or used: the counted reason and the reader's
+// message (a missing, truncated or malformed file or message).
 struct ScanRead {
-  std::optional<elo::PointCloud> cloud;
+  std::optional<elo::LoadedScan> scan;
   std::string reason;
   std::string detail;
 };
 
-ScanRead readScan(const elo::Sequence& sequence, size_t index, size_t& non_finite_points) {
+ScanRead readScan(const elo::ScanSource& source, size_t index) {
   try {
-    size_t non_finite = 0;
-    elo::PointCloud cloud = sequence.load(index, &non_finite);
-    non_finite_points += non_finite;
-    return {std::move(cloud), "", ""};
-  } catch (const elo::IoError& error) {
-    return {std::nullopt, "scan file unreadable", error.what()};
+    return {source.read(index), "", ""};
+  } catch (const elo::UnusableScan& error) {
+    return {std::nullopt, error.reason(), error.what()};
   }
 }
 
@@ -200,6 +207,8 @@ class Report {
     total_.push_back(result.times.total);
   }
   void addUnreadable(const std::string& reason) { ++unreadable_[reason]; }
+  // How long reading one scan took (file or message, decoded and converted): outside the pipeline's total.
+  void addReading(double milliseconds) { reading_.push_back(milliseconds); }
 
   void print(elo::Odometry& odometry, size_t scans, size_t non_finite_points, double wall_seconds) const {
     if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
@@ -229,6 +238,9 @@ class Report {
       std::printf("%-22s %10.2f %10.2f\n", name, s.mean, s.median);
     }
     const double mean_total = summarise(total_).mean;
+    const StageSummary reading = summarise(reading_);
+    std::printf("%-22s %10.2f %10.2f   (not in the total: %.1f %% of it)\n", "reading scans", reading.mean, reading.median,
+                mean_total > 0.0 ? 100.0 * reading.mean / mean_total : 0.0);
     const StageSummary upload = summarise(upload_);
     if (upload.mean > 0.0) {
       std::printf("%-22s %10.3f %10.3f   (%s)\n", "scan upload to GPU", upload.mean, upload.median,
@@ -247,7 +259,7 @@ class Report {
 
  private:
   bool prefetching_;
-  std::vector<double> projection_, upload_, features_, registration_, model_update_, total_;
+  std::vector<double> projection_, upload_, features_, registration_, model_update_, total_, reading_;
   std::map<std::string, size_t> unreadable_;
 };
 
@@ -274,10 +286,10 @@ struct Trajectory {
   std::vector<double> stamps;
 };
 
-void writeTrajectory(const Options& options, const elo::Sequence& sequence, const Trajectory& trajectory) {
+void writeTrajectory(const Options& options, const elo::ScanSource& source, const Trajectory& trajectory) {
   elo::writeKittiPoses(options.output, trajectory.poses);
-  if (sequence.hasCalibration()) {
-    elo::writeKittiPoses(cameraOutputPath(options), elo::lidarToCamera(trajectory.poses, sequence.calibration()));
+  if (source.hasCalibration()) {
+    elo::writeKittiPoses(cameraOutputPath(options), elo::lidarToCamera(trajectory.poses, source.calibration()));
   }
   if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, trajectory.stamps, trajectory.poses);
 }
@@ -287,8 +299,8 @@ void writeTrajectory(const Options& options, const elo::Sequence& sequence, cons
 // line repeats the last pose) or, with --strict, ends the run with an IoError.
 class ScanLoop {
  public:
-  ScanLoop(const Options& options, const elo::Sequence& sequence, elo::Odometry& odometry)
-      : options_(options), sequence_(sequence), odometry_(odometry), report_(options.prefetch) {
+  ScanLoop(const Options& options, const elo::ScanSource& source, elo::Odometry& odometry)
+      : options_(options), source_(source), odometry_(odometry), report_(options.prefetch) {
     if (options.timing_csv.empty()) return;
     timing_.open(options.timing_csv);
     if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
@@ -318,17 +330,21 @@ class ScanLoop {
  private:
   // Reads the scan, stamped as played, and prefetches it unless --no-prefetch.
   ScanRead readPlayed(const elo::PlayedScan& played) {
-    ScanRead read = readScan(sequence_, played.index, non_finite_points_);
-    if (read.cloud) {
-      read.cloud->stamp = played.stamp;
-      if (options_.prefetch) odometry_.prefetch(*read.cloud);
+    const auto start = std::chrono::steady_clock::now();
+    ScanRead read = readScan(source_, played.index);
+    report_.addReading(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (read.scan) {
+      non_finite_points_ += read.scan->non_finite_points;
+      read.scan->cloud.stamp = played.stamp;
+      if (options_.prefetch) odometry_.prefetch(read.scan->cloud);
     }
     return read;
   }
 
   elo::FrameResult processScan(size_t scan, const ScanRead& read) {
-    if (!read.cloud) return skipUnreadable(scan, read);
-    const elo::FrameResult result = odometry_.process(*read.cloud);
+    if (!read.scan) return skipUnreadable(scan, read);
+    warnOnce(scan, read.scan->warning);
+    const elo::FrameResult result = odometry_.process(read.scan->cloud);
     if (!result.sensor_warning.empty() && odometry_.sensorMisfitCount() == 1) {  // the first; the summary counts them
       std::fprintf(stderr, "\nscan %zu: warning: %s\n", scan, result.sensor_warning.c_str());
     }
@@ -354,11 +370,17 @@ class ScanLoop {
   }
 
   const Options& options_;
-  const elo::Sequence& sequence_;
+  // Each warning a reader gave, said once: a driver's fields are the same in every cloud.
+  void warnOnce(size_t scan, const std::string& warning) {
+    if (!warning.empty() && warned_.insert(warning).second) std::fprintf(stderr, "\nscan %zu: warning: %s\n", scan, warning.c_str());
+  }
+
+  const elo::ScanSource& source_;
   elo::Odometry& odometry_;
   std::ofstream timing_;
   Report report_;
   size_t non_finite_points_ = 0;
+  std::set<std::string> warned_;
 };
 
 int run(const Options& options) {
@@ -367,23 +389,27 @@ int run(const Options& options) {
     std::cout << elo::dumpConfigYaml(config);
     return 0;
   }
-  const elo::Sequence sequence(options.input);
-  const std::vector<elo::PlayedScan> played = elo::playOrder(sequence, options.stride, options.reverse, options.max_frames);
+  const auto opening = std::chrono::steady_clock::now();
+  const std::unique_ptr<elo::ScanSource> source = elo_ros::openScanSource(options.input, options.topic);
+  std::printf("input: %s, %zu scans, listed in %.2f s\n", source->describe().c_str(), source->size(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - opening).count());
+  if (!source->warning().empty()) std::fprintf(stderr, "warning: %s\n", source->warning().c_str());
+  const std::vector<elo::PlayedScan> played = elo::playOrder(*source, options.stride, options.reverse, options.max_frames);
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
-  ScanLoop loop(options, sequence, odometry);
+  ScanLoop loop(options, *source, odometry);
   Trajectory trajectory;
   const auto start = std::chrono::steady_clock::now();
   try {
     loop.run(played, trajectory);
   } catch (const std::exception&) {
-    writeTrajectory(options, sequence, trajectory);
+    writeTrajectory(options, *source, trajectory);
     std::fprintf(stderr, "\nelo_run: stopped after %zu of %zu scans; their poses are in %s\n", trajectory.poses.size(),
                  played.size(), options.output.c_str());
     throw;
   }
   const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  writeTrajectory(options, sequence, trajectory);
+  writeTrajectory(options, *source, trajectory);
   loop.report().print(odometry, played.size(), loop.nonFinitePoints(), wall_seconds);
   return 0;
 }

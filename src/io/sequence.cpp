@@ -106,6 +106,16 @@ PointCloud Sequence::load(size_t index, size_t* non_finite_skipped) const {
   return cloud;
 }
 
+LoadedScan Sequence::read(size_t index) const {
+  LoadedScan scan;
+  try {
+    scan.cloud = load(index, &scan.non_finite_points);
+  } catch (const IoError& error) {
+    throw UnusableScan("scan file unreadable", error.what());
+  }
+  return scan;
+}
+
 double Sequence::stamp(size_t index) const {
   checkIndex(index);
   return stamps_.empty() ? kDefaultScanPeriod * static_cast<double>(index) : stamps_[index];
@@ -123,19 +133,6 @@ const std::vector<Eigen::Isometry3d>& Sequence::groundTruth() const {
     throw IoError("sequence '" + directory_ + "' has no poses.txt");
   }
   return ground_truth_;
-}
-
-std::vector<PlayedScan> playOrder(const Sequence& sequence, size_t stride, bool reverse, size_t max_frames) {
-  if (stride == 0) throw std::invalid_argument("the stride between played scans must be at least 1");
-  std::vector<PlayedScan> played;
-  for (size_t index = 0; index < sequence.size(); index += stride) played.push_back({index, sequence.stamp(index)});
-  if (reverse) {
-    const double mirror = played.front().stamp + played.back().stamp;
-    std::reverse(played.begin(), played.end());
-    for (PlayedScan& scan : played) scan.stamp = mirror - scan.stamp;
-  }
-  if (max_frames > 0 && played.size() > max_frames) played.resize(max_frames);
-  return played;
 }
 
 }  // namespace elo

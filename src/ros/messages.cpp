@@ -17,7 +17,7 @@ class VertexCloud {
   VertexCloud(const std_msgs::Header& header, bool with_normals) : with_normals_(with_normals) {
     message_.header = header;
     message_.height = 1;
-    message_.is_bigendian = hostIsBigEndian();
+    message_.is_bigendian = elo::hostIsBigEndian();
     message_.is_dense = true;
     const char* names[] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
     const int field_count = with_normals ? 6 : 3;

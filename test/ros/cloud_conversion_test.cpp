@@ -41,7 +41,7 @@ sensor_msgs::PointCloud2 makeMessage(const std::vector<FieldSpec>& fields, uint3
   message.width = width;
   message.height = height;
   message.row_step = point_step * width + row_padding;
-  message.is_bigendian = elo_ros::hostIsBigEndian();
+  message.is_bigendian = elo::hostIsBigEndian();
   message.data.assign(static_cast<size_t>(message.row_step) * height, 0);
   return message;
 }
@@ -299,7 +299,7 @@ TEST(CloudConversion, SwapsBytesOfTheOtherByteOrder) {
   put(pointAt(message, 0, 0), 12, static_cast<uint16_t>(0x0102));
   for (const uint32_t offset : {0u, 4u, 8u}) std::reverse(pointAt(message, 0, 0) + offset, pointAt(message, 0, 0) + offset + 4);
   std::reverse(pointAt(message, 0, 0) + 12, pointAt(message, 0, 0) + 14);
-  message.is_bigendian = !elo_ros::hostIsBigEndian();
+  message.is_bigendian = !elo::hostIsBigEndian();
 
   const elo_ros::ConvertedCloud converted = elo_ros::fromPointCloud2(message);
   ASSERT_TRUE(converted.usable()) << converted.detail;
@@ -313,7 +313,7 @@ void expectRejected(const sensor_msgs::PointCloud2& message, CloudProblem proble
   EXPECT_EQ(converted.problem, problem) << converted.detail;
   EXPECT_NE(converted.detail.find(naming), std::string::npos) << "'" << converted.detail << "' should name '" << naming << "'";
   EXPECT_TRUE(converted.cloud.points.empty());
-  EXPECT_STRNE(elo_ros::describe(problem), "usable");
+  EXPECT_STRNE(elo::describe(problem), "usable");
 }
 
 TEST(CloudConversion, RejectsACloudWithoutCoordinates) {

@@ -1,7 +1,9 @@
 // elo_run over a simulated sequence with scans it cannot read: a truncated or malformed scan is skipped,
 // counted by reason and its pose line repeats the last pose, so that the lines still match the scans;
 // --strict stops at such a scan with a non-zero exit, after writing the poses of the scans before it.
-// --no-prefetch changes no pose.
+// --no-prefetch changes no pose. The same drive as a ROS 1 bag (kitti_to_bag) and a ROS 2 bag (our test
+// writer) gives the directory's poses bit for bit; malformed, truncated and empty bags are clear errors or
+// counted skips that keep the poses computed so far.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -11,7 +13,12 @@
 #include <string>
 #include <vector>
 
+#include <rosbag/bag.h>
+
+#include "../io/ros2_bag_writer.hpp"
 #include "../io/temp_directory.hpp"
+#include "cloud_conversion.hpp"
+#include "elo/io/kitti.hpp"
 #include "elo/io/pcd.hpp"
 #include "elo/io/sequence.hpp"
 
@@ -179,6 +186,181 @@ TEST_F(EloRunCli, PrefetchingChangesNoPose) {
   const std::vector<std::string> written = lines(poses());
   EXPECT_EQ(written.size(), kScans);
   EXPECT_EQ(lines(directory_.file("prefetched.txt")), written);
+}
+
+// kitti_to_bag's start time: the bag's header stamps are the sequence's times plus this.
+constexpr double kBagStartTime = 1.0;
+
+CommandResult writeRos1Bag(const std::string& sequence, const std::string& bag) {
+  return runCommand(std::string(KITTI_TO_BAG_TOOL) + " --input " + sequence + " --output " + bag +
+                    " --poses-frame lidar");
+}
+
+// The sequence's scans as a ROS 2 bag, stamped as kitti_to_bag stamps them.
+void writeRos2Bag(const std::string& sequence_path, const std::string& bag) {
+  const elo::Sequence sequence(sequence_path);
+  elo::test::Ros2BagWriter writer(bag);
+  const int64_t topic = writer.addTopic("/points");
+  for (size_t i = 0; i < sequence.size(); ++i) {
+    const elo::test::Stamp stamp = elo::test::stampOf(sequence.stamp(i) + kBagStartTime);
+    writer.write(topic, int64_t{stamp.sec} * 1000000000 + stamp.nanosec,
+                 elo::test::encodeCdrPointCloud2(sequence.load(i), stamp));
+  }
+}
+
+TEST_F(EloRunCli, Ros1BagGivesTheSequencesPosesBitForBit) {
+  const std::string bag = directory_.file("drive.bag");
+  const CommandResult written = writeRos1Bag(sequence_.string(), bag);
+  ASSERT_EQ(written.exit_code, 0) << written.output;
+  const CommandResult result = runEloRunOn(bag, poses(), "--tum " + directory_.file("poses.tum"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(lines(poses()), intact_poses_);
+  EXPECT_TRUE(contains(result.output, "6 scans, 6 processed")) << result.output;
+  // The TUM stamps are the clouds' header stamps.
+  std::vector<double> stamps;
+  elo::readTumPoses(directory_.file("poses.tum"), &stamps);
+  const elo::Sequence sequence(sequence_.string());
+  ASSERT_EQ(stamps.size(), kScans);
+  for (size_t i = 0; i < kScans; ++i) EXPECT_NEAR(stamps[i], sequence.stamp(i) + kBagStartTime, 1e-6) << i;
+}
+
+TEST_F(EloRunCli, Ros2BagGivesTheSequencesPosesBitForBit) {
+  writeRos2Bag(sequence_.string(), directory_.file("drive_ros2"));
+  const CommandResult result = runEloRunOn(directory_.file("drive_ros2"), poses());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(lines(poses()), intact_poses_);
+}
+
+TEST_F(EloRunCli, BagWithSeveralCloudTopicsNeedsTopic) {
+  const std::string bag = directory_.file("two.bag");
+  {
+    const elo::Sequence sequence(sequence_.string());
+    rosbag::Bag writer(bag, rosbag::bagmode::Write);
+    for (size_t i = 0; i < sequence.size(); ++i) {
+      elo::PointCloud cloud = sequence.load(i);
+      cloud.stamp += kBagStartTime;
+      const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      writer.write("/front/points", message.header.stamp, message);
+      if (i < 2) writer.write("/rear/points", message.header.stamp, message);
+    }
+  }
+  const CommandResult ambiguous = runEloRunOn(bag, poses());
+  EXPECT_EQ(ambiguous.exit_code, 1) << ambiguous.output;
+  EXPECT_TRUE(contains(ambiguous.output, "/front/points (sensor_msgs/PointCloud2, 6 messages)")) << ambiguous.output;
+  EXPECT_TRUE(contains(ambiguous.output, "/rear/points (sensor_msgs/PointCloud2, 2 messages)")) << ambiguous.output;
+  EXPECT_TRUE(contains(ambiguous.output, "--topic")) << ambiguous.output;
+  const CommandResult chosen = runEloRunOn(bag, poses(), "--topic /front/points");
+  ASSERT_EQ(chosen.exit_code, 0) << chosen.output;
+  EXPECT_EQ(lines(poses()), intact_poses_);
+}
+
+// A cloud whose data is shorter than its header promises, as a driver bug or a cut recording leaves it:
+// skipped and counted under the conversion's reason, as the nodelet counts it; --strict stops there.
+TEST_F(EloRunCli, MalformedCloudInABagIsSkippedAndCounted) {
+  const std::string bag = directory_.file("malformed.bag");
+  {
+    const elo::Sequence sequence(sequence_.string());
+    rosbag::Bag writer(bag, rosbag::bagmode::Write);
+    for (size_t i = 0; i < sequence.size(); ++i) {
+      elo::PointCloud cloud = sequence.load(i);
+      cloud.stamp += kBagStartTime;
+      sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      if (i == 2) message.data.resize(message.data.size() / 2);
+      writer.write("/points", message.header.stamp, message);
+    }
+  }
+  const CommandResult result = runEloRunOn(bag, poses());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans);
+  EXPECT_EQ(written[1], intact_poses_[1]);
+  EXPECT_EQ(written[2], written[1]) << "the unusable cloud repeats the last pose";
+  EXPECT_TRUE(contains(result.output, "scan 2 skipped: truncated data")) << result.output;
+  EXPECT_TRUE(contains(result.output, "5 processed, 1 skipped (truncated data)")) << result.output;
+
+  const CommandResult strict = runEloRunOn(bag, poses(), "--strict");
+  EXPECT_EQ(strict.exit_code, 1) << strict.output;
+  EXPECT_EQ(lines(poses()), std::vector<std::string>(intact_poses_.begin(), intact_poses_.begin() + 2));
+}
+
+TEST_F(EloRunCli, TruncatedAndEmptyRos1BagsAreClearErrors) {
+  const std::string bag = directory_.file("cut.bag");
+  ASSERT_EQ(writeRos1Bag(sequence_.string(), bag).exit_code, 0);
+  fs::resize_file(bag, fs::file_size(bag) / 2);
+  const CommandResult cut = runEloRunOn(bag, poses());
+  EXPECT_EQ(cut.exit_code, 1) << cut.output;
+  EXPECT_TRUE(contains(cut.output, "cut.bag")) << cut.output;
+  EXPECT_TRUE(contains(cut.output, "rosbag reindex")) << cut.output;
+
+  const std::string empty = directory_.file("empty.bag");
+  { rosbag::Bag writer(empty, rosbag::bagmode::Write); }
+  const CommandResult nothing = runEloRunOn(empty, poses());
+  EXPECT_EQ(nothing.exit_code, 1) << nothing.output;
+  EXPECT_TRUE(contains(nothing.output, "has no sensor_msgs/PointCloud2 topic; its topics: none")) << nothing.output;
+
+  std::ofstream(directory_.file("drive.mcap")) << "\x89MCAP0\r\n";
+  const CommandResult mcap = runEloRunOn(directory_.file("drive.mcap"), poses());
+  EXPECT_EQ(mcap.exit_code, 1) << mcap.output;
+  EXPECT_TRUE(contains(mcap.output, "ros2 bag convert")) << mcap.output;
+}
+
+// A ROS 2 bag cut short (a copy interrupted) whose message table SQLite can no longer follow is a clear
+// error naming the damaged file. A message that does not decode is skipped and counted, or --strict stops
+// at it; the poses before it are kept either way.
+TEST_F(EloRunCli, TruncatedOrMalformedRos2Bag) {
+  const std::string cut = directory_.file("cut_ros2");
+  writeRos2Bag(sequence_.string(), cut);
+  fs::resize_file(cut + "/cut_ros2_0.db3", fs::file_size(cut + "/cut_ros2_0.db3") / 2);
+  const CommandResult truncated = runEloRunOn(cut, poses());
+  EXPECT_EQ(truncated.exit_code, 1) << truncated.output;
+  EXPECT_TRUE(contains(truncated.output, "cut_ros2_0.db3' is damaged")) << truncated.output;
+
+  const std::string bag = directory_.file("bad_ros2");
+  {
+    const elo::Sequence sequence(sequence_.string());
+    elo::test::Ros2BagWriter writer(bag);
+    const int64_t topic = writer.addTopic("/points");
+    for (size_t i = 0; i < sequence.size(); ++i) {
+      const elo::test::Stamp stamp = elo::test::stampOf(sequence.stamp(i) + kBagStartTime);
+      std::vector<uint8_t> message = elo::test::encodeCdrPointCloud2(sequence.load(i), stamp);
+      if (i == 3) message.resize(message.size() - 1000);  // its point data cut short
+      writer.write(topic, int64_t{stamp.sec} * 1000000000 + stamp.nanosec, message);
+    }
+  }
+  const CommandResult result = runEloRunOn(bag, poses());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(written[i], intact_poses_[i]) << i;
+  EXPECT_EQ(written[3], written[2]);
+  EXPECT_TRUE(contains(result.output, "scan 3 skipped: message unreadable")) << result.output;
+  EXPECT_TRUE(contains(result.output, "5 processed, 1 skipped (message unreadable)")) << result.output;
+
+  const CommandResult strict = runEloRunOn(bag, poses(), "--strict");
+  EXPECT_EQ(strict.exit_code, 1) << strict.output;
+  EXPECT_EQ(lines(poses()), std::vector<std::string>(intact_poses_.begin(), intact_poses_.begin() + 3));
+}
+
+// A simulated drive whose sensor moves during each sweep, each point's time in the clouds' `time` field
+// (elo_sim --bag): elo_run deskews it from the bag as it does from the PCD scans beside it, which is
+// what the nodelet does (test/ros/sim_deskew_test.cpp).
+TEST_F(EloRunCli, BagWithPerPointTimesDeskewsAsTheScansOnDisk) {
+  const std::string sequence = directory_.file("distorted");
+  const std::string bag = directory_.file("distorted.bag");
+  const CommandResult simulated = runCommand(
+      std::string(ELO_SIM_TOOL) + " --world urban --trajectory curves --sensor vlp16 --seed 3 --frames 8 --threads 2 "
+      "--deskewed 0 --time-convention field --format pcd --output " + sequence + " --bag " + bag);
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  const auto run = [&](const std::string& input, const std::string& output, const std::string& source) {
+    return runCommand(std::string(ELO_RUN_TOOL) + " --input " + input + " --output " + output + " --config " +
+                      ELO_SOURCE_DIR + "/config/vlp16.yaml --threads 2 --quiet --set deskew.time_source=" + source);
+  };
+  ASSERT_EQ(run(sequence, directory_.file("disk.txt"), "field").exit_code, 0);
+  const CommandResult from_bag = run(bag, directory_.file("bag.txt"), "field");
+  ASSERT_EQ(from_bag.exit_code, 0) << from_bag.output;
+  EXPECT_EQ(lines(directory_.file("bag.txt")), lines(directory_.file("disk.txt")));
+  ASSERT_EQ(run(bag, directory_.file("undeskewed.txt"), "none").exit_code, 0);
+  EXPECT_NE(lines(directory_.file("undeskewed.txt")), lines(directory_.file("bag.txt"))) << "the times were used";
 }
 
 }  // namespace

@@ -11,28 +11,32 @@
 #include <string>
 #include <vector>
 
+#include "elo/io/scan_source.hpp"
 #include "elo/types.hpp"
 
 namespace elo {
 
-class Sequence {
+class Sequence : public ScanSource {
  public:
   // Throws IoError for a missing directory, no scans, mixed .pcd/.bin scans, or a side file that
   // cannot be parsed or whose line count differs from the scan count.
   explicit Sequence(const std::string& directory);
 
-  size_t size() const { return scan_paths_.size(); }
+  size_t size() const override { return scan_paths_.size(); }
   const std::string& directory() const { return directory_; }
   const std::string& path(size_t index) const;
 
   // The scan with its `stamp`: from times.txt, or index * 0.1 s (10 Hz) without one. PCD points with
   // non-finite coordinates are skipped and counted (see readPcd).
   PointCloud load(size_t index, size_t* non_finite_skipped = nullptr) const;
-  double stamp(size_t index) const;
+  double stamp(size_t index) const override;
+  // load() as a ScanSource: an IoError becomes an UnusableScan counted as "scan file unreadable".
+  LoadedScan read(size_t index) const override;
+  std::string describe() const override { return "sequence '" + directory_ + "'"; }
 
-  bool hasCalibration() const { return calibration_.has_value(); }
+  bool hasCalibration() const override { return calibration_.has_value(); }
   // The velodyne->camera `Tr` of calib.txt; throws IoError when the sequence has none.
-  const Eigen::Isometry3d& calibration() const;
+  const Eigen::Isometry3d& calibration() const override;
 
   bool hasGroundTruth() const { return !ground_truth_.empty(); }
   // poses.txt as written: for KITTI, camera-frame poses (cameraToLidar converts them).
@@ -50,18 +54,5 @@ class Sequence {
   std::optional<Eigen::Isometry3d> calibration_;
   std::vector<Eigen::Isometry3d> ground_truth_;
 };
-
-// One scan of a run over a sequence: which scan, and the stamp the run gives it.
-struct PlayedScan {
-  size_t index;
-  double stamp;
-};
-
-// The scans a run plays, in order: every `stride`-th scan from the first (a faster drive, or dropped
-// frames) and, with `reverse`, last to first; at most `max_frames` of them (0: all). A reverse run drives
-// the route backwards rather than back in time: its stamps are mirrored about the played span, so they
-// still advance by the recorded intervals. Per-point times within a scan are not mirrored. Throws
-// std::invalid_argument for a stride of 0.
-std::vector<PlayedScan> playOrder(const Sequence& sequence, size_t stride, bool reverse, size_t max_frames = 0);
 
 }  // namespace elo
