@@ -90,6 +90,15 @@ class DriveMap {
     std::vector<Voxel> voxels;
   };
 
+  // A point of DriveMap::add()'s batch on its way into its voxel.
+  struct PendingPoint {
+    Block* block = nullptr;  // null: left out
+    uint16_t cell = 0;       // within the block
+    uint32_t voxel = 0;      // index into the block's voxels
+    Vec3f offset;            // from the block's corner
+  };
+  static constexpr size_t kBatch = 32;
+
   bool kept(const Voxel& voxel) const;
   Block* blockFor(const Eigen::Vector3i& block_coordinates);
 

@@ -97,43 +97,66 @@ void DriveMap::add(const MapScan& scan) {
   // Neighbouring pixels mostly share a block: the last one found is tried first.
   Eigen::Vector3i last_block(0, 0, 0);
   Block* block = nullptr;
-  for (size_t i = 0; i < scan.points.size(); ++i) {
-    const Vec3f point = rotation * scan.points[i] + translation;
-    // Beyond a kilometre from the sensor: not a measurement (and too far for an int voxel index).
-    if (!(point.cwiseAbs().maxCoeff() < kMaxDistance)) {
-      ++outside_;
-      continue;
-    }
-    const Eigen::Vector3i voxel = (point * voxels_per_metre).array().floor().cast<int>();
-    // Floor division by kBlockSide (a power of two): an arithmetic shift, also for negative indices.
-    const Eigen::Vector3i relative_block(voxel.x() >> kBlockShift, voxel.y() >> kBlockShift, voxel.z() >> kBlockShift);
-    if (block == nullptr || relative_block != last_block) {
-      block = blockFor(anchor_block + relative_block);
-      last_block = relative_block;
+  // A voxel is mostly a cache miss, and so is its slot: the points go in batches, each step of a batch
+  // first asking for the memory the next step reads, so that the misses overlap.
+  std::array<PendingPoint, kBatch> batch;
+  for (size_t begin = 0; begin < scan.points.size(); begin += kBatch) {
+    const size_t count = std::min(kBatch, scan.points.size() - begin);
+    for (size_t k = 0; k < count; ++k) {
+      PendingPoint& pending = batch[k];
+      pending.block = nullptr;
+      const Vec3f point = rotation * scan.points[begin + k] + translation;
+      // Beyond a kilometre from the sensor: not a measurement (and too far for an int voxel index).
+      if (!(point.cwiseAbs().maxCoeff() < kMaxDistance)) {
+        ++outside_;
+        continue;
+      }
+      const Eigen::Vector3i voxel = (point * voxels_per_metre).array().floor().cast<int>();
+      // Floor division by kBlockSide (a power of two): an arithmetic shift, also for negative indices.
+      const Eigen::Vector3i relative_block(voxel.x() >> kBlockShift, voxel.y() >> kBlockShift, voxel.z() >> kBlockShift);
+      if (block == nullptr || relative_block != last_block) {
+        block = blockFor(anchor_block + relative_block);
+        last_block = relative_block;
+      }
       if (block == nullptr) {
         ++outside_;
         continue;
       }
+      const Eigen::Vector3i cell = voxel - relative_block * kBlockSide;
+      pending.block = block;
+      pending.cell = static_cast<uint16_t>((cell.z() * kBlockSide + cell.y()) * kBlockSide + cell.x());
+      pending.offset = point - relative_block.cast<float>() * block_size_float;
+      __builtin_prefetch(&block->slot[pending.cell]);
     }
-    const Eigen::Vector3i cell = voxel - relative_block * kBlockSide;
-    uint16_t& slot = block->slot[(cell.z() * kBlockSide + cell.y()) * kBlockSide + cell.x()];
-    if (slot == 0) {
-      block->voxels.emplace_back();
-      slot = static_cast<uint16_t>(block->voxels.size());
-      ++voxels_;
+    for (size_t k = 0; k < count; ++k) {
+      PendingPoint& pending = batch[k];
+      if (pending.block == nullptr) continue;
+      uint16_t& slot = pending.block->slot[pending.cell];
+      if (slot == 0) {
+        pending.block->voxels.emplace_back();
+        slot = static_cast<uint16_t>(pending.block->voxels.size());
+        ++voxels_;
+      }
+      pending.voxel = slot - 1u;
+      __builtin_prefetch(&pending.block->voxels[pending.voxel]);
     }
-    Voxel& target = block->voxels[slot - 1];
-    target.position_sum += point - relative_block.cast<float>() * block_size_float;
-    target.intensity_sum += scan.intensity[i];
-    ++target.points;
-    target.ground_points += scan.ground[i];
-    if (!scan.normals[i].isZero()) {
-      target.normal_sum += rotation * scan.normals[i];
-      ++target.normals;
-    }
-    if (target.last_scan != scan_number) {
-      target.last_scan = scan_number;
-      ++target.scans;
+    for (size_t k = 0; k < count; ++k) {
+      const PendingPoint& pending = batch[k];
+      if (pending.block == nullptr) continue;
+      const size_t i = begin + k;
+      Voxel& target = pending.block->voxels[pending.voxel];
+      target.position_sum += pending.offset;
+      target.intensity_sum += scan.intensity[i];
+      ++target.points;
+      target.ground_points += scan.ground[i];
+      if (!scan.normals[i].isZero()) {
+        target.normal_sum += rotation * scan.normals[i];
+        ++target.normals;
+      }
+      if (target.last_scan != scan_number) {
+        target.last_scan = scan_number;
+        ++target.scans;
+      }
     }
   }
 }

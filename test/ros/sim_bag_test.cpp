@@ -119,7 +119,9 @@ void expectTheDrivesMap(ros::NodeHandle& node, LatestMessage<sensor_msgs::PointC
   const sensor_msgs::PointCloud2 shown = map_topic.latest();
   EXPECT_EQ(shown.header.frame_id, "odom");
   EXPECT_EQ(fieldNames(shown), (std::vector<std::string>{"x", "y", "z", "intensity"}));
-  EXPECT_GT(shown.width, 10000u);
+  // The 3 s drive is shorter than ~map_publish_period: the message is the map after the first scan, its
+  // road (a non-ground voxel waits for three scans).
+  EXPECT_GT(shown.width, 5000u);
 }
 
 TEST(SimulatedBag, NodeletInManagerMatchesTheCoreInProcess) {
