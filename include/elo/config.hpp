@@ -162,7 +162,7 @@ struct DeskewConfig {
 // The drive's map (docs/map.md): elo_run --map, the node's ~save_map and `map` topic.
 struct MapConfig {
   // Edge of a map voxel (m). Fine enough for curbs, poles and facades' relief; coarse enough that the
-  // map costs about 0.1 GiB a kilometre of urban street (docs/map.md) and that a VLP-16's rings, 2 deg
+  // map costs about 0.13 GiB a kilometre of urban street (docs/map.md) and that a VLP-16's rings, 2 deg
   // apart (0.35 m at 10 m), still leave few empty voxels on a surface driven past. An HDL-64E's rings lie
   // 0.4 deg apart (0.14 m at 20 m).
   double voxel_size = 0.2;
