@@ -31,13 +31,14 @@ Eigen::Vector3i unpackKey(uint64_t key) {
   return block;
 }
 
-// Of a row of the range image, the columns a map scan takes at range `range`: every `stride`-th, where
-// `stride` columns still span less than a voxel, so that each voxel the row crosses keeps a point.
-// Close in, where a voxel spans several columns, their points would all add to one centroid: an
-// HDL-64E scan keeps about a third of its points at 0.2 m voxels (docs/map.md, cost).
-int columnStride(float range, float column_angle, float voxel_size) {
-  const float stride = voxel_size / std::max(range * column_angle, 1e-6f);
-  return std::clamp(static_cast<int>(stride), 1, kMaxColumnStride);
+// Of a row of the range image, the columns a map scan takes at range `range`: every `stride`-th, a
+// power of two up to kMaxColumnStride, where `stride` columns still span less than a voxel
+// (`columns_per_voxel_metre` / range columns do), so that each voxel the row crosses keeps a point.
+// Close in, where a voxel spans several columns, their points would all add to one centroid.
+int columnStride(float range, float columns_per_voxel_metre) {
+  int stride = 1;
+  while (stride < kMaxColumnStride && 2.0f * stride * range <= columns_per_voxel_metre) stride *= 2;
+  return stride;
 }
 
 }  // namespace
@@ -49,12 +50,13 @@ MapScan mapScanOf(const ScanImage& scan, const PointCloud& cloud, const Eigen::I
   result.stamp = stamp;
   const SphericalImage& image = scan.image;
   const bool has_intensity = !cloud.intensity.empty();
-  const float column_angle = static_cast<float>(2.0 * M_PI / std::max(image.cols, 1));
+  // Columns a voxel spans at 1 m: the voxel over the angle between neighbouring columns.
+  const float columns_per_voxel_metre = static_cast<float>(voxel_size * std::max(image.cols, 1) / (2.0 * M_PI));
   for (int row = 0; row < image.rows; ++row) {
     for (int col = 0; col < image.cols; ++col) {
       const size_t pixel = static_cast<size_t>(row) * image.cols + col;
       if (!image.occupied(pixel)) continue;
-      if (col % columnStride(image.range[pixel], column_angle, static_cast<float>(voxel_size)) != 0) continue;
+      if ((col & (columnStride(image.range[pixel], columns_per_voxel_metre) - 1)) != 0) continue;
       const Vec3f& point = image.vertex[pixel];
       // The pipeline's normals have either sign; the map's face the sensor (at the origin), so that the
       // normals of one surface seen from one side add up.
