@@ -16,10 +16,13 @@
 #include <string>
 #include <vector>
 
+#include "core/elapsed_time.hpp"
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/io/scan_source.hpp"
+#include "elo/map_builder.hpp"
 #include "elo/odometry.hpp"
 #include "command_line.hpp"
 #include "scan_sources.hpp"
@@ -52,6 +55,10 @@ options:
   --timing CSV         per-frame stage times, iterations, deskew rounds, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw; a bag's
                        stamps are its clouds' header stamps)
+  --map FILE.pcd       write the drive's map (docs/map.md): binary PCD, x y z intensity normal_x
+                       normal_y normal_z, one point per voxel, in the first scan's sensor frame; also
+                       when the run fails part-way
+  --map-voxel METERS   the map's voxel edge (map.voxel_size; default 0.2)
   --camera-output FILE camera-frame poses (default: POSES with _camera before the extension)
   --strict             stop at the first scan that cannot be read and exit 1 (after writing the
                        poses of the scans before it), instead of skipping it
@@ -70,6 +77,7 @@ struct Options {
   std::string timing_csv;
   std::string tum_output;
   std::string camera_output;
+  std::string map_output;
   std::vector<std::pair<std::string, std::string>> overrides;
   size_t max_frames = 0;
   size_t stride = 1;
@@ -118,6 +126,10 @@ Options parseArguments(int argc, char** argv) {
       options.timing_csv = arguments.value();
     } else if (arguments.is("--tum")) {
       options.tum_output = arguments.value();
+    } else if (arguments.is("--map")) {
+      options.map_output = arguments.value();
+    } else if (arguments.is("--map-voxel")) {
+      options.overrides.emplace_back("map.voxel_size", arguments.value());
     } else if (arguments.is("--camera-output")) {
       options.camera_output = arguments.value();
     } else if (arguments.is("--strict")) {
@@ -209,6 +221,7 @@ class Report {
   void addUnreadable(const std::string& reason) { ++unreadable_[reason]; }
   // How long reading one scan took (file or message, decoded and converted): outside the pipeline's total.
   void addReading(double milliseconds) { reading_.push_back(milliseconds); }
+  double meanTotalMilliseconds() const { return summarise(total_).mean; }
 
   void print(elo::Odometry& odometry, size_t scans, size_t non_finite_points, double wall_seconds) const {
     if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
@@ -294,13 +307,64 @@ void writeTrajectory(const Options& options, const elo::ScanSource& source, cons
   if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, trajectory.stamps, trajectory.poses);
 }
 
+// The drive's map (--map): every processed scan that registered in every direction is handed to the
+// map's thread; the map is written when the run ends, or fails part-way.
+class MapOutput {
+ public:
+  MapOutput(const std::string& path, const elo::MapConfig& config)
+      : path_(path), builder_(config, kMaxQueued) {}
+
+  void add(elo::Odometry& odometry, const elo::FrameResult& result, const elo::PointCloud& cloud) {
+    if (result.reset) builder_.clear();  // the poses before the reset lie in another frame
+    if (!result.processed) return;
+    if (result.registration.degeneracy.any()) {
+      ++degenerate_;
+      return;
+    }
+    const double start = elo::threadCpuSeconds();
+    elo::MapScan scan = elo::mapScanOf(odometry.backend().scan(), cloud, odometry.modelPose(), cloud.stamp,
+                                       odometry.config().map.voxel_size);
+    copy_seconds_ += elo::threadCpuSeconds() - start;
+    if (!builder_.add(std::move(scan))) std::fprintf(stderr, "\nwarning: the map's thread fell behind: a scan left out of the map\n");
+  }
+
+  // Writes the map; returns what was written, for the summary.
+  std::string write() {
+    const elo::MapCloud map = builder_.points();
+    elo::writeMapPcd(path_, map);
+    const elo::MapBuilder::Statistics statistics = builder_.statistics();
+    char text[400];
+    std::snprintf(text, sizeof(text),
+                  "map: %zu points of %zu voxels from %zu scans (%zu degenerate scans left out, %zu dropped) in %.0f MiB, "
+                  "written to %s",
+                  map.size(), statistics.voxels, statistics.scans, degenerate_, statistics.dropped,
+                  statistics.memory_bytes / 1048576.0, path_.c_str());
+    return text;
+  }
+
+  // CPU milliseconds a scan: copying its points on the odometry's thread, and adding them on the map's.
+  std::pair<double, double> costPerScan() {
+    const elo::MapBuilder::Statistics statistics = builder_.statistics();
+    const double scans = std::max<double>(statistics.scans, 1.0);
+    return {1000.0 * copy_seconds_ / scans, 1000.0 * statistics.busy_seconds / scans};
+  }
+
+ private:
+  // Scans waiting for the map's thread; it adds a scan in a tenth of the time the odometry takes.
+  static constexpr size_t kMaxQueued = 32;
+  std::string path_;
+  elo::MapBuilder builder_;
+  size_t degenerate_ = 0;
+  double copy_seconds_ = 0.0;
+};
+
 // Reads and processes every played scan, appending its pose to `trajectory` as it goes, so that the
 // caller can write the poses computed before any failure. A scan that cannot be read is skipped (its
 // line repeats the last pose) or, with --strict, ends the run with an IoError.
 class ScanLoop {
  public:
-  ScanLoop(const Options& options, const elo::ScanSource& source, elo::Odometry& odometry)
-      : options_(options), source_(source), odometry_(odometry), report_(options.prefetch) {
+  ScanLoop(const Options& options, const elo::ScanSource& source, elo::Odometry& odometry, MapOutput* map)
+      : options_(options), source_(source), odometry_(odometry), map_(map), report_(options.prefetch) {
     if (options.timing_csv.empty()) return;
     timing_.open(options.timing_csv);
     if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
@@ -354,6 +418,7 @@ class ScanLoop {
       std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", scan);
     }
     report_.add(result, odometry_.backend().lastUploadMilliseconds());
+    if (map_ != nullptr) map_->add(odometry_, result, *read.cloud);
     return result;
   }
 
@@ -377,11 +442,22 @@ class ScanLoop {
 
   const elo::ScanSource& source_;
   elo::Odometry& odometry_;
+  MapOutput* map_;
   std::ofstream timing_;
   Report report_;
   size_t non_finite_points_ = 0;
   std::set<std::string> warned_;
 };
+
+// A failed run still writes the map of the scans before the failure; a map that cannot be written then
+// is reported, and the run's own failure is the one that ends it.
+void writeMapAfterFailure(MapOutput& map) {
+  try {
+    std::fprintf(stderr, "elo_run: %s\n", map.write().c_str());
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "elo_run: cannot write the map: %s\n", error.what());
+  }
+}
 
 int run(const Options& options) {
   const elo::Config config = loadConfig(options);
@@ -397,7 +473,9 @@ int run(const Options& options) {
   const std::vector<elo::PlayedScan> played = elo::playOrder(*source, options.stride, options.reverse, options.max_frames);
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
-  ScanLoop loop(options, *source, odometry);
+  std::optional<MapOutput> map;
+  if (!options.map_output.empty()) map.emplace(options.map_output, config.map);
+  ScanLoop loop(options, *source, odometry, map ? &*map : nullptr);
   Trajectory trajectory;
   const auto start = std::chrono::steady_clock::now();
   try {
@@ -406,11 +484,19 @@ int run(const Options& options) {
     writeTrajectory(options, *source, trajectory);
     std::fprintf(stderr, "\nelo_run: stopped after %zu of %zu scans; their poses are in %s\n", trajectory.poses.size(),
                  played.size(), options.output.c_str());
+    if (map) writeMapAfterFailure(*map);
     throw;
   }
   const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   writeTrajectory(options, *source, trajectory);
   loop.report().print(odometry, played.size(), loop.nonFinitePoints(), wall_seconds);
+  if (map) {
+    std::printf("%s\n", map->write().c_str());
+    const auto [copy_ms, add_ms] = map->costPerScan();
+    const double pipeline_ms = loop.report().meanTotalMilliseconds();
+    std::printf("map cost a scan (CPU time): %.2f ms copying its points (odometry's thread), %.2f ms adding them "
+                "(map's thread); the pipeline took %.1f ms (wall)\n", copy_ms, add_ms, pipeline_ms);
+  }
   return 0;
 }
 

@@ -160,6 +160,20 @@ struct DeskewConfig {
   int rounds = 1;
 };
 
+// The drive's map (docs/map.md): elo_run --map, the node's ~save_map and `map` topic.
+struct MapConfig {
+  // Edge of a map voxel (m). Fine enough for curbs, poles and facades' relief; coarse enough that the
+  // map costs about 0.13 GiB a kilometre of urban street (docs/map.md) and that a VLP-16's rings, 2 deg
+  // apart (0.35 m at 10 m), still leave few empty voxels on a surface driven past. An HDL-64E's rings lie
+  // 0.4 deg apart (0.14 m at 20 m).
+  double voxel_size = 0.2;
+  // The moving-object filter: a non-ground voxel is written only when this many scans saw it. A car
+  // driving at v m/s stays in a voxel for (its length / v) s, 4-5 scans at 10 m/s; a wall driven past is
+  // seen by tens of scans. Ground voxels are always written (the road does not move, and a sparse
+  // sensor's rings cross a ground voxel only once or twice). 1 writes every voxel.
+  int min_observations = 3;
+};
+
 struct RuntimeConfig {
   BackendKind backend = BackendKind::cpu;
   // With backend cuda and no usable GPU: run on the CPU backend with a warning instead of failing.
@@ -175,6 +189,7 @@ struct Config {
   RegistrationConfig registration;
   ModelConfig model;
   DeskewConfig deskew;
+  MapConfig map;
   RuntimeConfig runtime;
 };
 
@@ -200,6 +215,7 @@ std::vector<Parameter> parameters(Config& config);
 
 // Throws ConfigError naming the first parameter whose value cannot work (e.g. a zero image width).
 void validate(const Config& config);
+void validate(const MapConfig& map);
 
 // Converts a value read as text (command line, YAML scalar) to the parameter's type and sets it.
 void setFromString(const Parameter& parameter, const std::string& text);

@@ -188,12 +188,20 @@ std::vector<Parameter> parameters(Config& c) {
                  "times, relative to its stamp), azimuth (from each point's azimuth; reference mid-sweep)"),
       bindField("deskew.rounds", c.deskew.rounds,
                 "rounds of deskewing again under the motion estimated so far, one after each of the registration's first Gauss-Newton steps"),
+      bindField("map.voxel_size", c.map.voxel_size, "edge of a voxel of the drive's map, m (docs/map.md)"),
+      bindField("map.min_observations", c.map.min_observations,
+                "scans that must see a non-ground voxel of the drive's map for it to be written (moving objects)"),
       bindChoice("runtime.backend", c.runtime.backend,
                  {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
       bindField("runtime.backend_fallback", c.runtime.backend_fallback,
                 "with backend cuda and no usable GPU, run on the CPU backend with a warning instead of failing"),
       bindField("runtime.threads", c.runtime.threads, "CPU threads, 0 = all"),
   };
+}
+
+void validate(const MapConfig& map) {
+  require(map.voxel_size >= 0.01 && map.voxel_size <= 10.0, "map.voxel_size", "must lie in [0.01, 10] m");
+  require(map.min_observations >= 1 && map.min_observations <= 1000, "map.min_observations", "must lie in [1, 1000]");
 }
 
 void validate(const Config& c) {
@@ -267,6 +275,7 @@ void validate(const Config& c) {
   require(c.model.same_surface_distance >= 0.0, "model.same_surface_distance", "must not be negative");
   require(std::isfinite(s.sweep_start_azimuth_deg), "sensor.sweep_start_azimuth_deg", "must be finite");
   require(c.deskew.rounds >= 0 && c.deskew.rounds <= 5, "deskew.rounds", "must lie in [0, 5]");
+  validate(c.map);
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
 }
 

@@ -14,7 +14,7 @@
 #include "text_format.hpp"
 
 namespace elo {
-namespace {
+namespace io_detail {
 
 using pcl::PCLPointField;
 
@@ -54,6 +54,49 @@ double readScalar(const uint8_t* bytes, uint8_t datatype) {
 bool isFloatingPoint(uint8_t datatype) {
   return datatype == PCLPointField::FLOAT32 || datatype == PCLPointField::FLOAT64;
 }
+
+void addField(pcl::PCLPointCloud2& cloud, const std::string& name, uint8_t datatype, uint32_t size) {
+  PCLPointField field;
+  field.name = name;
+  field.offset = cloud.point_step;
+  field.datatype = datatype;
+  field.count = 1;
+  cloud.fields.push_back(field);
+  cloud.point_step += size;
+}
+
+// The whole file in one read: a scan is a few MB, and the parser checks its sizes against it.
+std::string readFileBytes(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw IoError("cannot read '" + path + "': no such file");
+  }
+  std::ifstream stream = io_detail::openForReading(path, std::ios::binary);
+  std::error_code error;
+  const auto size = static_cast<size_t>(std::filesystem::file_size(path, error));
+  if (error) {
+    throw IoError("cannot read the size of '" + path + "': " + error.message());
+  }
+  std::string bytes(size, '\0');
+  if (!stream.read(bytes.data(), static_cast<std::streamsize>(size))) {
+    throw IoError("reading '" + path + "' failed after " + std::to_string(stream.gcount()) + " bytes");
+  }
+  return bytes;
+}
+
+void savePcd(const std::string& path, const pcl::PCLPointCloud2& cloud) {
+  if (pcl::io::savePCDFile(path, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true) != 0) {
+    throw IoError("cannot write '" + path + "'");
+  }
+}
+
+}  // namespace io_detail
+namespace {
+
+using pcl::PCLPointField;
+using io_detail::findField;
+using io_detail::isFloatingPoint;
+using io_detail::readScalar;
+using io_detail::addField;
 
 // The fields of a PCD scan that a PointCloud holds, checked once so that the per-point loop only reads.
 struct FieldLayout {
@@ -111,43 +154,15 @@ void appendPoint(const uint8_t* point, const Vec3f& position, const FieldLayout&
   }
 }
 
-void addField(pcl::PCLPointCloud2& cloud, const std::string& name, uint8_t datatype, uint32_t size) {
-  PCLPointField field;
-  field.name = name;
-  field.offset = cloud.point_step;
-  field.datatype = datatype;
-  field.count = 1;
-  cloud.fields.push_back(field);
-  cloud.point_step += size;
-}
-
 template <typename T>
 void writeScalar(uint8_t* point, const PCLPointField& field, T value) {
   std::memcpy(point + field.offset, &value, sizeof(T));
 }
 
-// The whole file in one read: a scan is a few MB, and the parser checks its sizes against it.
-std::string readFileBytes(const std::string& path) {
-  std::ifstream stream = io_detail::openForReading(path, std::ios::binary);
-  std::error_code error;
-  const auto size = static_cast<size_t>(std::filesystem::file_size(path, error));
-  if (error) {
-    throw IoError("cannot read the size of '" + path + "': " + error.message());
-  }
-  std::string bytes(size, '\0');
-  if (!stream.read(bytes.data(), static_cast<std::streamsize>(size))) {
-    throw IoError("reading '" + path + "' failed after " + std::to_string(stream.gcount()) + " bytes");
-  }
-  return bytes;
-}
-
 }  // namespace
 
 PointCloud readPcd(const std::string& path, size_t* non_finite_skipped) {
-  if (!std::filesystem::is_regular_file(path)) {
-    throw IoError("cannot read '" + path + "': no such file");
-  }
-  const io_detail::PcdPoints pcd = io_detail::parsePcd(readFileBytes(path), path);
+  const io_detail::PcdPoints pcd = io_detail::parsePcd(io_detail::readFileBytes(path), path);
   const FieldLayout layout = findLayout(pcd.fields, path);
   PointCloud cloud;
   size_t skipped = 0;
@@ -192,9 +207,7 @@ void writePcd(const std::string& path, const PointCloud& cloud) {
     if (has_ring) writeScalar(point, pcd.fields[4], cloud.ring[i]);
     if (has_time) writeScalar(point, pcd.fields.back(), cloud.time[i]);
   }
-  if (pcl::io::savePCDFile(path, pcd, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true) != 0) {
-    throw IoError("cannot write '" + path + "'");
-  }
+  io_detail::savePcd(path, pcd);
 }
 
 }  // namespace elo

@@ -5,10 +5,12 @@
 // malformed file is an IoError naming the file and the line.
 #pragma once
 
+#include <pcl/PCLPointCloud2.h>
 #include <pcl/PCLPointField.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,5 +25,17 @@ struct PcdPoints {
 
 // `bytes` is the whole file, `path` its name for messages.
 PcdPoints parsePcd(const std::string& bytes, const std::string& path);
+
+// Shared by the readers and writers of scans (pcd.cpp) and maps (map_pcd.cpp), defined in pcd.cpp.
+std::optional<pcl::PCLPointField> findField(const std::vector<pcl::PCLPointField>& fields, const std::string& name);
+// Any PCD scalar at `bytes` (not necessarily aligned) as a double.
+double readScalar(const uint8_t* bytes, uint8_t datatype);
+bool isFloatingPoint(uint8_t datatype);
+// Appends a one-value field of `size` bytes to the cloud's point layout.
+void addField(pcl::PCLPointCloud2& cloud, const std::string& name, uint8_t datatype, uint32_t size);
+// The whole file; IoError when it is missing or cannot be read.
+std::string readFileBytes(const std::string& path);
+// Binary PCD; IoError when it cannot be written.
+void savePcd(const std::string& path, const pcl::PCLPointCloud2& cloud);
 
 }  // namespace elo::io_detail

@@ -4,6 +4,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <Eigen/Cholesky>
+#include <cstring>
 
 #include "cloud_conversion.hpp"
 #include "elo/se3.hpp"
@@ -102,6 +103,32 @@ sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::Pixe
     if (scan.label[pixel] == label) cloud.add(image.vertex[pixel], image.normal[pixel]);
   }
   return cloud.finish();
+}
+
+sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 message;
+  message.header = header;
+  message.height = 1;
+  message.width = static_cast<uint32_t>(map.size());
+  message.is_bigendian = hostIsBigEndian();
+  message.is_dense = true;
+  const char* names[] = {"x", "y", "z", "intensity"};
+  for (int i = 0; i < 4; ++i) {
+    sensor_msgs::PointField field;
+    field.name = names[i];
+    field.offset = static_cast<uint32_t>(i * sizeof(float));
+    field.datatype = sensor_msgs::PointField::FLOAT32;
+    field.count = 1;
+    message.fields.push_back(field);
+  }
+  message.point_step = 4 * sizeof(float);
+  message.row_step = message.point_step * message.width;
+  message.data.resize(message.row_step);
+  for (size_t i = 0; i < map.size(); ++i) {
+    const float values[4] = {map.points[i].x(), map.points[i].y(), map.points[i].z(), map.intensity[i]};
+    std::memcpy(message.data.data() + i * message.point_step, values, sizeof(values));
+  }
+  return message;
 }
 
 elo::PointCloud modelPoints(const elo::Model& model, const Eigen::Isometry3d& transform) {

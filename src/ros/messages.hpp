@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <optional>
 
+#include "elo/drive_map.hpp"
 #include "elo/odometry.hpp"
 #include "elo/types.hpp"
 
@@ -27,6 +28,9 @@ sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_
 // ground pixels as x y z.
 sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::PixelLabel label,
                                            const std_msgs::Header& header);
+
+// The drive's map for display: x y z intensity, float32, one point per map point.
+sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Header& header);
 
 // The model as one point list for elo::writePcd, moved by `transform` (sensor -> odom frame).
 elo::PointCloud modelPoints(const elo::Model& model, const Eigen::Isometry3d& transform);

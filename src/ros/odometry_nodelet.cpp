@@ -4,6 +4,7 @@
 
 #include "cloud_conversion.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/io/pcd.hpp"
 
 namespace elo_ros {
@@ -12,6 +13,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kWarningPeriod = 5.0;  // s between repeats of one throttled warning
+// Scans waiting for the map's thread: a second of a 10 Hz sensor (about 15 MB for an HDL-64E). The map
+// adds a scan in a few milliseconds; the queue fills only when its thread gets no CPU for a second.
+constexpr size_t kMapQueue = 10;
 
 std::string joined(const std::vector<std::string>& names) {
   std::string text;
@@ -30,6 +34,10 @@ void OdometryNodelet::onInit() {
     throw;
   }
   if (!odometry_->backendWarning().empty()) NODELET_WARN("%s", odometry_->backendWarning().c_str());
+  if (settings_.build_map) {
+    map_ = std::make_unique<elo::MapBuilder>(odometry_->config().map, kMapQueue,
+                                             [this](const elo::DriveMap& map, const elo::MapScan& scan) { publishMap(map, scan); });
+  }
   if (!settings_.publish_sensor_frame_directly) {
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, getNodeHandle());
@@ -84,10 +92,13 @@ void OdometryNodelet::advertise() {
   model_ground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("model/ground", 1);
   scan_ground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("scan/ground", 1);
   scan_nonground_publisher_ = node.advertise<sensor_msgs::PointCloud2>("scan/nonground", 1);
+  // Latched: rviz, started late, still shows the map.
+  if (map_) map_publisher_ = node.advertise<sensor_msgs::PointCloud2>("map", 1, true);
   ros::NodeHandle& private_node = getPrivateNodeHandle();
   reset_service_ = private_node.advertiseService("reset", &OdometryNodelet::onReset, this);
   save_trajectory_service_ = private_node.advertiseService("save_trajectory", &OdometryNodelet::onSaveTrajectory, this);
   save_map_service_ = private_node.advertiseService("save_map", &OdometryNodelet::onSaveMap, this);
+  save_model_service_ = private_node.advertiseService("save_model", &OdometryNodelet::onSaveModel, this);
 }
 
 OdometryNodelet::~OdometryNodelet() {
@@ -98,6 +109,7 @@ OdometryNodelet::~OdometryNodelet() {
   if (waiting > 0) NODELET_INFO("finishing %zu queued scans before stopping", waiting);
   queue_->close();
   worker_.join();
+  map_.reset();  // its thread publishes through members destroyed before it
   if (!settings_.save_trajectory_on_shutdown) return;
   try {
     NODELET_INFO("%s", saveTrajectory(settings_.outputs).c_str());
@@ -190,12 +202,43 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   header.stamp = message.header.stamp;
   header.frame_id = frames_->sensor_frame;
   const ScanMessages messages = buildMessages(result, dt, header);
+  const Eigen::Isometry3d map_pose = frames_->sensorPose(odometry_->modelPose());
+  const size_t map_generation = map_generation_;
   lock.unlock();
 
   // After ros::shutdown the node only finishes its queue (for the trajectory): there is no one to tell.
   if (ros::ok()) publish(messages);
   const double latency_ms = std::chrono::duration<double, std::milli>(Clock::now() - queued.received).count();
   statistics_.scanProcessed(result, latency_ms);
+  feedMap(result, converted.cloud, map_pose, map_generation);
+}
+
+void OdometryNodelet::feedMap(const elo::FrameResult& result, const elo::PointCloud& cloud,
+                              const Eigen::Isometry3d& sensor_pose, size_t generation) {
+  // Registered with a degenerate direction, the scan's pose along it is the motion prior's: left out.
+  if (!map_ || result.registration.degeneracy.any()) return;
+  std::unique_lock<std::mutex> lock(odometry_mutex_);
+  if (generation != map_generation_) return;  // ~reset since: the pose lies in the old odom frame
+  // Only this thread processes scans: the backend still holds this one.
+  elo::MapScan scan = elo::mapScanOf(odometry_->backend().scan(), cloud, sensor_pose, cloud.stamp,
+                                     odometry_->config().map.voxel_size);
+  if (!map_->add(std::move(scan))) {
+    NODELET_WARN_THROTTLE(kWarningPeriod, "the map's thread fell behind: a scan left out of the drive's map");
+  }
+}
+
+void OdometryNodelet::publishMap(const elo::DriveMap& map, const elo::MapScan& scan) {
+  if (settings_.map_publish_period <= 0.0 || !ros::ok()) return;
+  // Also when time went backwards (a bag replayed again): the map restarted with the odometry.
+  const bool due = !last_map_stamp_ || scan.stamp >= *last_map_stamp_ + settings_.map_publish_period ||
+                   scan.stamp < *last_map_stamp_;
+  if (!due) return;
+  last_map_stamp_ = scan.stamp;
+  const size_t limit = static_cast<size_t>(settings_.map_publish_points);
+  std_msgs::Header header;
+  header.stamp.fromSec(scan.stamp);
+  header.frame_id = settings_.odom_frame;
+  map_publisher_.publish(mapCloud(map.points((map.voxelCount() + limit - 1) / limit), header));
 }
 
 void OdometryNodelet::reportRestart(const elo::FrameResult& result, double stamp) {
@@ -263,6 +306,8 @@ void OdometryNodelet::forgetTrajectory() {
   trajectory_stamps_.clear();
   trajectory_poses_.clear();
   path_.clear();
+  if (map_) map_->clear();
+  ++map_generation_;
   last_processed_stamp_.reset();
   next_model_stamp_ = -std::numeric_limits<double>::infinity();
 }
@@ -305,15 +350,35 @@ bool OdometryNodelet::onSaveMap(std_srvs::Trigger::Request&, std_srvs::Trigger::
   try {
     const OutputFiles files = readOutputFiles(getPrivateNodeHandle());
     if (files.map_file.empty()) throw std::invalid_argument("~map_file is not set");
+    if (!map_) throw std::runtime_error("~build_map is false: no map was built");
+    // Every scan processed so far is in the map once it returns.
+    const elo::MapCloud map = map_->points();
+    elo::writeMapPcd(files.map_file, map);
+    const elo::MapBuilder::Statistics statistics = map_->statistics();
+    response.message = "wrote the drive's map, " + std::to_string(map.size()) + " points from " +
+                       std::to_string(statistics.scans) + " scans (" + settings_.odom_frame + " frame), to " +
+                       files.map_file;
+    response.success = true;
+  } catch (const std::exception& error) {
+    response.message = error.what();
+    response.success = false;
+  }
+  return true;
+}
+
+bool OdometryNodelet::onSaveModel(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  try {
+    const OutputFiles files = readOutputFiles(getPrivateNodeHandle());
+    if (files.model_file.empty()) throw std::invalid_argument("~model_file is not set");
     std::lock_guard<std::mutex> lock(odometry_mutex_);
     if (!frames_ || !last_processed_stamp_) throw std::runtime_error("no scan processed yet: the model is empty");
     // The model lives in the latest scan's frame at its reference instant (mid-sweep for per-point times
     // from the cloud: Odometry::modelPose()); the file holds it in the odom frame.
     const elo::PointCloud map =
         modelPoints(odometry_->backend().model(), frames_->sensorPose(odometry_->modelPose()));
-    elo::writePcd(files.map_file, map);
+    elo::writePcd(files.model_file, map);
     response.message = "wrote " + std::to_string(map.size()) + " model points (" + settings_.odom_frame +
-                       " frame) to " + files.map_file;
+                       " frame) to " + files.model_file;
     response.success = true;
   } catch (const std::exception& error) {
     response.message = error.what();

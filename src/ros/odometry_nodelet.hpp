@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "diagnostics.hpp"
+#include "elo/map_builder.hpp"
 #include "elo/odometry.hpp"
 #include "messages.hpp"
 #include "parameters.hpp"
@@ -61,6 +62,14 @@ class OdometryNodelet : public nodelet::Nodelet {
   bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSaveTrajectory(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSaveMap(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool onSaveModel(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  // Copies the processed scan's points for the drive's map, placed by `sensor_pose` (the odom frame);
+  // after the scan's messages are out, so that the map never delays a pose.
+  // `generation`: map_generation_ when the scan was processed; a scan from before a reset is left out.
+  void feedMap(const elo::FrameResult& result, const elo::PointCloud& cloud, const Eigen::Isometry3d& sensor_pose,
+               size_t generation);
+  // On the map's thread: the thinned map on `map`, every ~map_publish_period seconds of scan time.
+  void publishMap(const elo::DriveMap& map, const elo::MapScan& scan);
   std::string saveTrajectory(const OutputFiles& files);  // returns what it wrote; throws on failure
 
   NodeSettings settings_;
@@ -77,6 +86,10 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::vector<double> trajectory_stamps_;
   std::vector<Eigen::Isometry3d> trajectory_poses_;  // the sensor's, as elo_run writes them
   std::deque<geometry_msgs::PoseStamped> path_;
+  // The drive's map (docs/map.md) on a thread of its own; null with ~build_map false.
+  std::unique_ptr<elo::MapBuilder> map_;
+  size_t map_generation_ = 0;  // counts the resets that cleared the map
+  std::optional<double> last_map_stamp_;  // of the last `map` message; the map's thread's only
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
@@ -86,8 +99,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   ros::Subscriber cloud_subscriber_;
   ros::Publisher odometry_publisher_, path_publisher_;
   ros::Publisher model_nonground_publisher_, model_ground_publisher_;
-  ros::Publisher scan_ground_publisher_, scan_nonground_publisher_;
-  ros::ServiceServer reset_service_, save_trajectory_service_, save_map_service_;
+  ros::Publisher scan_ground_publisher_, scan_nonground_publisher_, map_publisher_;
+  ros::ServiceServer reset_service_, save_trajectory_service_, save_map_service_, save_model_service_;
 };
 
 }  // namespace elo_ros

@@ -166,12 +166,17 @@ NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {
   read("path_length", settings.path_length);
   read("model_publish_rate", settings.model_publish_rate);
   read("tf_timeout", settings.tf_timeout);
+  read("build_map", settings.build_map);
+  read("map_publish_period", settings.map_publish_period);
+  read("map_publish_points", settings.map_publish_points);
   read("save_trajectory_on_shutdown", settings.save_trajectory_on_shutdown);
   settings.outputs = readOutputFiles(private_node);
   if (settings.odom_frame.empty()) throw std::invalid_argument("~odom_frame must not be empty");
   if (settings.base_frame.empty()) throw std::invalid_argument("~base_frame must not be empty");
   if (settings.path_length < 0) throw std::invalid_argument("~path_length must not be negative");
   if (settings.model_publish_rate < 0.0) throw std::invalid_argument("~model_publish_rate must not be negative");
+  if (settings.map_publish_period < 0.0) throw std::invalid_argument("~map_publish_period must not be negative");
+  if (settings.map_publish_points < 1) throw std::invalid_argument("~map_publish_points must be positive");
   if (settings.tf_timeout < 0.0) throw std::invalid_argument("~tf_timeout must not be negative");
   parseTrajectoryFormat(settings.outputs.trajectory_format);
   return settings;
@@ -182,6 +187,7 @@ OutputFiles readOutputFiles(const ros::NodeHandle& private_node) {
   readSetting(private_node, "trajectory_file", files.trajectory_file);
   readSetting(private_node, "trajectory_format", files.trajectory_format);
   readSetting(private_node, "map_file", files.map_file);
+  readSetting(private_node, "model_file", files.model_file);
   return files;
 }
 

@@ -33,7 +33,8 @@ enum class TrajectoryFormat { kitti, tum };
 struct OutputFiles {
   std::string trajectory_file;
   std::string trajectory_format = "kitti";  // kitti | tum
-  std::string map_file;
+  std::string map_file;    // ~save_map: the drive's map (docs/map.md)
+  std::string model_file;  // ~save_model: the model, the last model.time_window seconds
 };
 
 // The node's own settings; the defaults are here and nowhere else.
@@ -48,6 +49,9 @@ struct NodeSettings {
   bool process_every_scan = false;
   int path_length = 1000;           // poses `path` keeps, the oldest dropped first; 0: no limit
   double model_publish_rate = 1.0;  // Hz of scan time for model/*; 0: never
+  bool build_map = true;            // the drive's map, for ~save_map and `map` (docs/map.md)
+  double map_publish_period = 5.0;  // s of scan time between `map` messages; 0: never
+  int map_publish_points = 500000;  // at most this many voxels in a `map` message (thinned evenly)
   double tf_timeout = 1.0;          // s to wait for the sensor -> base extrinsic on a scan
   OutputFiles outputs;
   bool save_trajectory_on_shutdown = false;  // write the trajectory file when the node stops (bag replay)

@@ -1,6 +1,7 @@
 // rostest (real_scans.test): the standalone node on the real HDL-64E scans of ../shared/data (a bag
 // that kitti_to_bag made at test time); skipped, saying so, where the data is absent. Every scan gives
-// odometry, the same as elo::Odometry in-process; ~save_trajectory, ~save_map and ~reset work. Prints
+// odometry, the same as elo::Odometry in-process; ~save_trajectory, ~save_map, ~save_model and ~reset
+// work. Prints
 // the throughput at full replay speed and the latency of scans sent one at a time.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <std_srvs/Trigger.h>
@@ -13,6 +14,7 @@
 
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/io/pcd.hpp"
 #include "rostest_helpers.hpp"
 
@@ -123,7 +125,12 @@ TEST(RealScans, StandaloneNodeOdometryAndServices) {
   node.setParam("elo_odometry/map_file", map_file);
   const std_srvs::Trigger::Response map = callTrigger("elo_odometry/save_map");
   ASSERT_TRUE(map.success) << map.message;
-  EXPECT_GT(elo::readPcd(map_file).size(), 10000u);
+  EXPECT_GT(elo::readMapPcd(map_file).size(), 50000u) << "the drive's map";
+  const std::string model_file = kData + "/real_scans_model.pcd";
+  node.setParam("elo_odometry/model_file", model_file);
+  const std_srvs::Trigger::Response model = callTrigger("elo_odometry/save_model");
+  ASSERT_TRUE(model.success) << model.message;
+  EXPECT_GT(elo::readPcd(model_file).size(), 10000u);
 
   // ~reset: the next scans start a new trajectory at the origin, even at later stamps that would
   // otherwise be registered against the old model. Sent one at a time to measure the latency.

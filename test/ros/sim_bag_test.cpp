@@ -1,14 +1,19 @@
 // rostest (sim_bag.test): the nodelet in a manager, fed a bag that kitti_to_bag made from an elo_sim
 // sequence. One odometry message per scan with the scan's stamp and REP-105 frames, a complete TF tree,
-// the path, the models and diagnostics, and a trajectory identical to elo::Odometry run in-process on
+// the path, the models, the drive's map (~save_map and `map`) and diagnostics, and a trajectory identical to elo::Odometry run in-process on
 // the same scans with the sequence's own stamps, as elo_run runs them; and the bag's ground truth.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <nav_msgs/Path.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <std_srvs/Trigger.h>
+
 #include <atomic>
+#include <fstream>
+#include <iterator>
 
 #include "elo/io/config_yaml.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "rostest_helpers.hpp"
 
 namespace {
@@ -74,6 +79,51 @@ TEST(SimulatedBag, CarriesTheGroundTruth) {
   EXPECT_EQ(truth.front().child_frame_id, "velodyne_ground_truth");
 }
 
+// ~save_map after the drive: a binary PCD of the drive's map with x y z intensity and normals, in the odom
+// frame (base_link on the road under the sensor at the first scan: the road lies at z = 0, where the
+// sensor frame has it 1.73 m lower), covering the drive; and the latched, thinned `map` topic.
+void expectTheDrivesMap(ros::NodeHandle& node, LatestMessage<sensor_msgs::PointCloud2>& map_topic, double driven) {
+  const std::string map_file = kData + "/sim_bag_map.pcd";
+  std::filesystem::remove(map_file);
+  node.setParam("elo_odometry/map_file", map_file);
+  std_srvs::Trigger trigger;
+  ASSERT_TRUE(ros::service::waitForService("elo_odometry/save_map", ros::Duration(10.0)));
+  ASSERT_TRUE(ros::service::call("elo_odometry/save_map", trigger));
+  ASSERT_TRUE(trigger.response.success) << trigger.response.message;
+  std::ifstream stream(map_file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  EXPECT_NE(bytes.find("FIELDS x y z intensity normal_x normal_y normal_z\n"), std::string::npos);
+  EXPECT_NE(bytes.find("DATA binary\n"), std::string::npos);
+  const elo::MapCloud map = elo::readMapPcd(map_file);
+  ASSERT_GT(map.size(), 50000u);
+  // The road within 10 m of the start: its height in the file's frame.
+  std::vector<float> road_heights;
+  size_t normals = 0;
+  float farthest = 0.0f;
+  for (size_t i = 0; i < map.size(); ++i) {
+    const elo::Vec3f& point = map.points[i];
+    if (point.head<2>().norm() < 10.0f && std::abs(point.z()) < 1.0f) road_heights.push_back(point.z());
+    if (!map.normals[i].isZero()) {
+      ++normals;
+      EXPECT_NEAR(map.normals[i].norm(), 1.0f, 1e-4f);
+    }
+    farthest = std::max(farthest, point.x());
+  }
+  ASSERT_GT(road_heights.size(), 100u) << "no road around the start at z = 0: not the odom frame";
+  std::nth_element(road_heights.begin(), road_heights.begin() + road_heights.size() / 2, road_heights.end());
+  EXPECT_NEAR(road_heights[road_heights.size() / 2], 0.0f, 0.1f);
+  EXPECT_GT(normals, map.size() / 10) << "normals where the pipeline has them";
+  EXPECT_GT(farthest, driven) << "the map reaches beyond the last pose";
+
+  ASSERT_TRUE(map_topic.waitForOne(5.0)) << "no `map` message";
+  const sensor_msgs::PointCloud2 shown = map_topic.latest();
+  EXPECT_EQ(shown.header.frame_id, "odom");
+  EXPECT_EQ(fieldNames(shown), (std::vector<std::string>{"x", "y", "z", "intensity"}));
+  // The 3 s drive is shorter than ~map_publish_period: the message is the map after the first scan, its
+  // road (a non-ground voxel waits for three scans).
+  EXPECT_GT(shown.width, 5000u);
+}
+
 TEST(SimulatedBag, NodeletInManagerMatchesTheCoreInProcess) {
   const std::string bag = kData + "/sim.bag";
   ASSERT_TRUE(std::filesystem::exists(bag)) << bag << " is made by the ctest fixture ros_make_sim_bag";
@@ -88,6 +138,7 @@ TEST(SimulatedBag, NodeletInManagerMatchesTheCoreInProcess) {
   LatestMessage<sensor_msgs::PointCloud2> nonground_model(node, "model/nonground");
   LatestMessage<sensor_msgs::PointCloud2> ground_model(node, "model/ground");
   LatestMessage<diagnostic_msgs::DiagnosticArray> diagnostics(node, "/diagnostics");
+  LatestMessage<sensor_msgs::PointCloud2> map_topic(node, "map");
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
 
@@ -145,6 +196,8 @@ TEST(SimulatedBag, NodeletInManagerMatchesTheCoreInProcess) {
   EXPECT_EQ(fieldNames(model), (std::vector<std::string>{"x", "y", "z", "normal_x", "normal_y", "normal_z"}));
   EXPECT_GT(model.width, 10000u);
   EXPECT_GT(ground_model.latest().width, 10000u);
+
+  expectTheDrivesMap(node, map_topic, sequence.groundTruth().back().translation().norm());
 
   // The node publishes its diagnostics once a second, which the drive may take less than.
   ASSERT_TRUE(diagnostics.waitForOne(5.0)) << "no /diagnostics message";

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -364,3 +365,28 @@ TEST_F(EloRunCli, BagWithPerPointTimesDeskewsAsTheScansOnDisk) {
 }
 
 }  // namespace
+
+// --map: the drive's map as a binary PCD when the run ends, and when it fails part-way (the scans before).
+size_t mapPoints(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  if (!contains(bytes, "FIELDS x y z intensity normal_x normal_y normal_z\n") || !contains(bytes, "DATA binary\n")) return 0;
+  const size_t points = bytes.find("\nPOINTS ");
+  return points == std::string::npos ? 0 : std::stoul(bytes.substr(points + 8));
+}
+
+TEST_F(EloRunCli, MapIsWrittenAtTheEndAndWhenTheRunFailsPartWay) {
+  const std::string map = directory_.file("map.pcd");
+  const CommandResult result = runEloRun("--map " + map + " --map-voxel 0.3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "map: ")) << result.output;
+  const size_t whole = mapPoints(map);
+  EXPECT_GT(whole, 5000u);
+
+  truncate(scanPath(sequence_, kScans - 1));
+  const std::string partial = directory_.file("partial.pcd");
+  EXPECT_EQ(runEloRun("--strict --map " + partial + " --map-voxel 0.3").exit_code, 1);
+  const size_t before_failure = mapPoints(partial);
+  EXPECT_GT(before_failure, 5000u) << "the map of the scans before the failure";
+  EXPECT_LT(before_failure, whole) << "one scan fewer";
+}

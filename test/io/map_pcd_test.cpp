@@ -1,0 +1,84 @@
+// The drive's map as a PCD file: written binary with the fields localization reads, read back exactly.
+#include "elo/io/map_pcd.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "elo/io/io_error.hpp"
+#include "elo/io/pcd.hpp"
+#include "temp_directory.hpp"
+
+namespace elo {
+namespace {
+
+using test::TempDirectory;
+
+MapCloud sampleMap() {
+  MapCloud map;
+  map.points = {Vec3f(1.5f, -2.25f, 0.125f), Vec3f(-1000.0f, 250.5f, -3.0f)};
+  map.intensity = {12.0f, 0.5f};
+  map.normals = {Vec3f(0, 0, 1), Vec3f::Zero()};
+  return map;
+}
+
+TEST(MapPcd, WritesBinaryXyzIntensityAndNormals) {
+  TempDirectory directory;
+  const std::string path = directory.file("map.pcd");
+  writeMapPcd(path, sampleMap());
+  std::ifstream stream(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  EXPECT_NE(bytes.find("FIELDS x y z intensity normal_x normal_y normal_z\n"), std::string::npos) << bytes.substr(0, 300);
+  EXPECT_NE(bytes.find("TYPE F F F F F F F\n"), std::string::npos);
+  EXPECT_NE(bytes.find("POINTS 2\n"), std::string::npos);
+  EXPECT_NE(bytes.find("DATA binary\n"), std::string::npos);
+}
+
+TEST(MapPcd, ReadsBackWhatItWrote) {
+  TempDirectory directory;
+  const std::string path = directory.file("map.pcd");
+  const MapCloud written = sampleMap();
+  writeMapPcd(path, written);
+  const MapCloud read = readMapPcd(path);
+  EXPECT_EQ(read.points, written.points);
+  EXPECT_EQ(read.intensity, written.intensity);
+  EXPECT_EQ(read.normals, written.normals);
+  // Any PCD reader sees x y z intensity.
+  const PointCloud scan = readPcd(path);
+  EXPECT_EQ(scan.points, written.points);
+  EXPECT_EQ(scan.intensity, written.intensity);
+}
+
+TEST(MapPcd, WritesAnEmptyMap) {
+  TempDirectory directory;
+  const std::string path = directory.file("empty.pcd");
+  writeMapPcd(path, MapCloud{});
+  EXPECT_EQ(readMapPcd(path).size(), 0u);
+}
+
+TEST(MapPcd, ReadsAScanWithoutNormalsAsAMapWithoutThem) {
+  TempDirectory directory;
+  const std::string path = directory.file("scan.pcd");
+  PointCloud scan;
+  scan.points = {Vec3f(1, 2, 3)};
+  scan.intensity = {4};
+  writePcd(path, scan);
+  const MapCloud map = readMapPcd(path);
+  ASSERT_EQ(map.size(), 1u);
+  EXPECT_EQ(map.intensity[0], 4.0f);
+  EXPECT_TRUE(map.normals[0].isZero());
+}
+
+TEST(MapPcd, SaysWhyAFileCannotBeReadOrWritten) {
+  EXPECT_THROW(readMapPcd("/nonexistent/map.pcd"), IoError);
+  EXPECT_THROW(writeMapPcd("/nonexistent/directory/map.pcd", sampleMap()), IoError);
+  TempDirectory directory;
+  const std::string path = directory.file("bad.pcd");
+  std::ofstream(path) << "VERSION .7\nFIELDS a b c\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                         "POINTS 1\nDATA ascii\n1 2 3\n";
+  EXPECT_THROW(readMapPcd(path), IoError);
+}
+
+}  // namespace
+}  // namespace elo
