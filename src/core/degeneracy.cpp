@@ -21,8 +21,8 @@ Vector6d scaling(double lever_arm) {
   return scale;
 }
 
-// Along a direction without any share the prior's information is capped here (in shares): the scan then
-// moves the estimate by 1e-6 of its pull there, where its pull is noise.
+// Along a direction without any share the prior's information is capped here (in shares of the scan's
+// translation information t): a pull g of the scan there, which is noise, moves the estimate by g / (1e4 t).
 constexpr double kLargestPriorInformation = 1e4;
 
 using ReducedMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
@@ -52,8 +52,8 @@ std::string describeDirection(const Vector6d& direction) {
 }  // namespace
 
 Vector6d Degeneracy::measuredShares() const {
-  const Vector6d squared = eigenvalues.cwiseMax(0.0).cwiseAbs2();
-  return (squared.array() / (squared.array() + threshold * threshold)).matrix();
+  const Eigen::Array<double, 6, 1> fourth = eigenvalues.cwiseMax(0.0).array().square().square();
+  return (fourth / (fourth + std::pow(threshold, 4))).matrix();
 }
 
 Matrix6d Degeneracy::priorShare() const {
@@ -103,16 +103,18 @@ std::optional<Degeneracy> analyseDegeneracy(const Matrix6d& hessian, double thre
 std::optional<Vector6d> priorWeightedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
                                           const Vector6d& gradient, const Vector6d& from_prior) {
   // In scaled coordinates s = D x (D = diag(1, 1, 1, L, L, L)) the prior adds t V diag(p) V^T to D^-1 H D^-1,
-  // t being H's translation trace, so that its information is a share of the scan's whatever the scene.
+  // t being H's translation trace, so that its information is a share of the scan's whatever the scene:
+  // p = tau^4 / lambda^3 against the scan's lambda leaves the scan lambda^4 / (lambda^4 + tau^4).
   const Vector6d unscale = scaling(degeneracy.lever_arm).cwiseInverse();
   Matrix6d system = unscale.asDiagonal() * hessian * unscale.asDiagonal();
   Vector6d right = -(unscale.asDiagonal() * gradient);
   if (degeneracy.threshold > 0.0) {
-    const double tau_squared = degeneracy.threshold * degeneracy.threshold;
+    const double tau_fourth = std::pow(degeneracy.threshold, 4);
     Vector6d information;
     for (int i = 0; i < 6; ++i) {
-      const double share = degeneracy.eigenvalues[i];
-      information[i] = share * kLargestPriorInformation > tau_squared ? tau_squared / share : kLargestPriorInformation;
+      const double share = std::max(degeneracy.eigenvalues[i], 0.0);
+      const double cubed = share * share * share;
+      information[i] = cubed * kLargestPriorInformation > tau_fourth ? tau_fourth / cubed : kLargestPriorInformation;
     }
     const Matrix6d prior = hessian.topLeftCorner<3, 3>().trace() * degeneracy.eigenvectors *
                            information.asDiagonal() * degeneracy.eigenvectors.transpose();
