@@ -2,8 +2,8 @@
 # Accuracy on simulated sequences with exact ground truth: every world with the HDL-64E, every other
 # sensor in the urban world (about 1 km each), the paper's Table II/III ablation on one urban drive
 # (Table III also with the normal gate opened, and with the simulator's clutter), and a drive through
-# KITTI 00's ground-truth poses when the shared data has them. Prints one table (KITTI metric t_rel and
-# r_rel, ATE, odometry FPS), then Table III on the real scans when the shared data has them: the gap
+# KITTI 00's ground-truth poses when the shared data has them. Prints one table (KITTI metric t_rel, its
+# horizontal part t_xy, r_rel, ATE, odometry FPS), then Table III on the real scans when the shared data has them: the gap
 # between runs forward and in reverse, which needs no ground truth; then the deskew table (issue 15,
 # docs/deskew_accuracy.md): urban and highway drives with the HDL-64E, VLP-16 and OS1-64 as instantaneous
 # scans and as sweeps with motion in both time conventions, without and with deskew.
@@ -27,8 +27,8 @@ mkdir -p "$work"
 table="$work/table.txt"
 : >"$table"
 [ "$only" = deskew ] ||
-  printf '%-18s %-8s %-5s %7s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' 'r_rel_deg/100m' ATE_m \
-    FPS | tee "$table"
+  printf '%-18s %-8s %-5s %7s %9s %9s %9s %15s %8s %6s\n' world/drive sensor mode frames length_m 't_rel_%' \
+    't_xy_%' 'r_rel_deg/100m' ATE_m FPS | tee "$table"
 
 # evaluate LABEL SENSOR MODE [--set KEY=VALUE]...: runs the odometry, configured for SENSOR, over the
 # sequence simulated for LABEL and SENSOR and adds a table row; --set variants are named in the row.
@@ -47,7 +47,7 @@ evaluate() {
     awk '/^FPS:/ {print $2}')
   "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$name.txt" | tail -n 1 |
     awk -v w="$label${variant:+ $variant}" -v s="$sensor" -v m="$mode" -v f="$fps" \
-      '{printf "%-18s %-8s %-5s %7d %9.1f %9.3f %15.4f %8.3f %6.1f\n", w, s, m, $2, $3, $4, $5, $8, f}' |
+      '{printf "%-18s %-8s %-5s %7d %9.1f %9.3f %9.3f %15.4f %8.3f %6.1f\n", w, s, m, $2, $3, $4, $9, $5, $8, f}' |
     tee -a "$table"
 }
 
@@ -69,8 +69,8 @@ simulate_and_evaluate() {
 # times, ground truth at mid-sweep). Each runs in both modes without deskew (time_source none) and, for
 # the distorted ones, with its convention's time source.
 deskew_table() {
-  printf '\n%-15s %-7s %-22s %-5s %9s %9s %15s %8s\n' 'deskew drive' sensor 'scans, time_source' mode \
-    length_m 't_rel_%' 'r_rel_deg/100m' ATE_m | tee -a "$table"
+  printf '\n%-15s %-7s %-22s %-5s %9s %9s %9s %15s %8s\n' 'deskew drive' sensor 'scans, time_source' mode \
+    length_m 't_rel_%' 't_xy_%' 'r_rel_deg/100m' ATE_m | tee -a "$table"
   local cell world sensor frames scans source mode dir
   # The ctest gates' drives (test/pipeline/test_deskew_accuracy.cpp), from rest: urban up to 10 m/s (166 m),
   # highway up to 25 m/s (190 m). The VLP-16 loses the highway drive even on instantaneous scans.
@@ -89,7 +89,7 @@ deskew_table() {
             --mode "$mode" --quiet --set "deskew.time_source=$source" >/dev/null
           "$bin/elo_eval" --gt "$dir/sequence/poses.txt" --est "$dir/$mode-$source.txt" | tail -n 1 |
             awk -v w="$world/curves" -v s="$sensor" -v k="$scans, $source" -v m="$mode" \
-              '{printf "%-15s %-7s %-22s %-5s %9.1f %9.3f %15.4f %8.3f\n", w, s, k, m, $3, $4, $5, $8}' |
+              '{printf "%-15s %-7s %-22s %-5s %9.1f %9.3f %9.3f %15.4f %8.3f\n", w, s, k, m, $3, $4, $9, $5, $8}' |
             tee -a "$table"
         done
       done

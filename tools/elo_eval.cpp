@@ -31,8 +31,8 @@ const char* const kUsage =
     "       elo_eval --est EST --reverse REV\n"
     "\n"
     "Evaluates estimated trajectories against ground truth with the KITTI odometry metric (t_rel, r_rel over\n"
-    "segments of 100..800 m), the relative pose error between consecutive frames and the absolute trajectory\n"
-    "error after a rigid alignment. Without ground truth, --map-entropy scores one trajectory by the sharpness\n"
+    "segments of 100..800 m; t_rel_xy: t_rel's horizontal part, the error's x-y in the LiDAR frame), the\n"
+    "relative pose error between consecutive frames and the absolute trajectory error after a rigid alignment. Without ground truth, --map-entropy scores one trajectory by the sharpness\n"
     "of the map its scans make, and --reverse by how far it and a run over the same scans in reverse fail to\n"
     "close.\n"
     "\n"
@@ -144,14 +144,15 @@ std::string plotPathFor(const std::string& png, const std::string& sequence) {
 }
 
 void printHeader() {
-  std::printf("%-10s %8s %11s %9s %16s %12s %11s %9s\n", "sequence", "frames", "length(m)", "t_rel(%)",
-              "r_rel(deg/100m)", "RPE_trans(m)", "RPE_rot(deg)", "ATE(m)");
+  std::printf("%-10s %8s %11s %9s %16s %12s %11s %9s %12s\n", "sequence", "frames", "length(m)", "t_rel(%)",
+              "r_rel(deg/100m)", "RPE_trans(m)", "RPE_rot(deg)", "ATE(m)", "t_rel_xy(%)");
 }
 
 void printRow(const elo::TrajectoryEvaluation& evaluation) {
-  std::printf("%-10s %8zu %11.1f %9.4f %16.4f %12.5f %11.5f %9.4f\n", evaluation.name.c_str(), evaluation.frames,
-              evaluation.length_m, evaluation.drift.t_rel_percent, evaluation.drift.r_rel_deg_per_100m,
-              evaluation.rpe.translation_rmse_m, evaluation.rpe.rotation_rmse_deg, evaluation.ate.translation_rmse_m);
+  std::printf("%-10s %8zu %11.1f %9.4f %16.4f %12.5f %11.5f %9.4f %12.4f\n", evaluation.name.c_str(),
+              evaluation.frames, evaluation.length_m, evaluation.drift.t_rel_percent,
+              evaluation.drift.r_rel_deg_per_100m, evaluation.rpe.translation_rmse_m, evaluation.rpe.rotation_rmse_deg,
+              evaluation.ate.translation_rmse_m, evaluation.drift.t_rel_horizontal_percent);
 }
 
 elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Options& options, bool plot_per_sequence) {

@@ -80,6 +80,9 @@ std::string usage() {
          "  --beam-elevation-error DEG\n"
          "                       standard deviation in degrees of each laser's constant elevation error\n"
          "                       (default 0); points are still reported along the nominal elevations\n"
+         "  --mirror 0|1         1: the drive in the world's mirror image (y -> -y; the sensor turns the\n"
+         "                       other way), left turns made right ones (default 0); not with\n"
+         "                       --time-convention azimuth\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -104,7 +107,8 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
-      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention"};
+      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
+      "--mirror"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -211,6 +215,10 @@ Options parseOptions(int argc, char** argv) {
   if (const auto error = take("--beam-elevation-error")) {
     spec.lidar.beam_elevation_error = elo::tools::parseNumber<double>("--beam-elevation-error", *error);
     if (spec.lidar.beam_elevation_error < 0.0) throw UsageError("--beam-elevation-error must not be negative");
+  }
+  if (const auto mirror = take("--mirror")) {
+    if (*mirror != "0" && *mirror != "1") throw UsageError("--mirror expects 0 or 1");
+    spec.mirrored = *mirror == "1";
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;

@@ -1,8 +1,11 @@
 // Degeneracy of a registration (Zhang, Kaess & Singh, "On Degeneracy of Optimization-based State
 // Estimation Problems", ICRA 2016): the directions of motion a scan does not constrain (along a long
 // tunnel, along a featureless motorway), read from the eigen-decomposition of the Gauss-Newton Hessian,
-// and the step that solves only the constrained directions, so that the degenerate ones stay where the
-// motion prior put them (solution remapping).
+// and the step that fades along them into the motion prior as their share of the constraint falls: the
+// prior holds information tau^4 / lambda^3 along an eigen direction of share lambda (tau the threshold),
+// so the scan decides lambda^4 / (lambda^4 + tau^4) of the estimate there. Well-constrained directions
+// are the scan's (94% at lambda = 2 tau, 99.99% at 10 tau), degenerate ones the prior's (6% at tau / 2,
+// 0.01% at tau / 10), and no threshold makes an edge between them (issue 31).
 //
 // The raw Hessian mixes units: the translation rows of the Jacobian are the normal n (dimensionless), the
 // rotation rows p x n carry the point's lever arm (m). Its eigenvalues compare m^0 with m^2, and a
@@ -28,12 +31,17 @@ struct Degeneracy {
   Vector6d eigenvalues = Vector6d::Zero();       // of the scaled Hessian, ascending
   Matrix6d eigenvectors = Matrix6d::Identity();  // matching unit columns, in scaled twist coordinates
   double lever_arm = 1.0;                        // L (m): the RMS lever arm of the correspondences
+  double threshold = 0.0;                        // tau: the share at which the scan and the prior weigh alike
   int count = 0;  // eigenvalues under the threshold: the first `count` eigenvectors are degenerate
 
   bool any() const { return count > 0; }
-  // Keeps the degenerate components of a twist (translation m, rotation rad) and drops the constrained
-  // ones, orthogonally in scaled coordinates (translation m, rotation times L: the arc it sweeps at L).
-  Matrix6d degenerateProjector() const;
+  // The share of the estimate the scan decides along each eigen direction, lambda^4 / (lambda^4 + tau^4):
+  // 1 with the handling off (tau 0).
+  Vector6d measuredShares() const;
+  // The part of a twist (translation m, rotation rad) that the prior holds: each eigen component scaled by
+  // 1 - its measured share, in scaled coordinates (translation m, rotation times L: the arc it sweeps at L).
+  // A projector onto the degenerate directions as their shares fall to 0.
+  Matrix6d priorShare() const;
   // The covariance of the estimated twist: `measurement_scale` * `hessian`^-1 within the constrained
   // directions (the residual variance over the inlier count), and `prior_variance` (m^2 in scaled
   // coordinates) along each degenerate one, where the estimate is the prior's.
@@ -47,11 +55,12 @@ struct Degeneracy {
 // Nullopt when H constrains no translation or no rotation at all.
 std::optional<Degeneracy> analyseDegeneracy(const Matrix6d& hessian, double threshold);
 
-// The Gauss-Newton step that minimises the linearised cost H, g within the constrained directions of
-// `degeneracy` (which may come from another Hessian than `hessian`): zero along the degenerate ones.
-// With none degenerate it is -H^-1 g. Nullopt when H is not positive definite within the constrained
-// directions.
-std::optional<Vector6d> constrainedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
-                                        const Vector6d& gradient);
+// The Gauss-Newton step that minimises the linearised cost H, g plus the motion prior's: information
+// tau^4 / lambda^3 (times H's translation trace, in scaled coordinates) along each eigen direction of
+// `degeneracy` (which may come from another Hessian than `hessian`), about the prior's estimate, from
+// which the current one lies `from_prior` (log of estimate * prior^-1). With the handling off it is
+// -H^-1 g. Nullopt when the system is not positive definite.
+std::optional<Vector6d> priorWeightedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
+                                          const Vector6d& gradient, const Vector6d& from_prior);
 
 }  // namespace elo

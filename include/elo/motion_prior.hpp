@@ -16,10 +16,11 @@ class MotionModel {
   Eigen::Isometry3d predict(double dt) const;
   // Records the estimated increment T^{t-1}_t that spanned `dt` seconds.
   void record(const Eigen::Isometry3d& increment, double dt);
-  // The increment just recorded came from a registration that kept the prediction along the directions
-  // `projector` keeps (a degenerate scan): its acceleration there was extrapolated, not observed. Zeroing
-  // it continues the motion along them at constant velocity; extrapolating it again, scan after scan,
-  // would integrate an acceleration nobody saw (1 mm/scan^2 is 5 m after 10 s at 10 Hz).
+  // The increment just recorded came from a registration that kept the prediction in the part of a twist
+  // `projector` keeps (Degeneracy::priorShare: all of it along a degenerate direction): its acceleration
+  // there was extrapolated, not observed. Zeroing that part continues the motion at constant velocity;
+  // extrapolating it again, scan after scan, would integrate an acceleration nobody saw (1 mm/scan^2 is
+  // 5 m after 10 s at 10 Hz).
   void holdVelocityAlong(const Matrix6d& projector);
   void reset() { history_ = 0; }
   // The velocity (twist per second) of the increment recorded last; zero before any. What a sweep is

@@ -21,6 +21,10 @@ Vector6d scaling(double lever_arm) {
   return scale;
 }
 
+// Along a direction without any share the prior's information is capped here (in shares of the scan's
+// translation information t): a pull g of the scan there, which is noise, moves the estimate by g / (1e4 t).
+constexpr double kLargestPriorInformation = 1e4;
+
 using ReducedMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
 // The Hessian within the constrained directions, in their coordinates: V_c^T D^-1 H D^-1 V_c, where D
@@ -47,10 +51,17 @@ std::string describeDirection(const Vector6d& direction) {
 
 }  // namespace
 
-Matrix6d Degeneracy::degenerateProjector() const {
-  const auto degenerate = eigenvectors.leftCols(count);
+Vector6d Degeneracy::measuredShares() const {
+  const Eigen::Array<double, 6, 1> fourth = eigenvalues.cwiseMax(0.0).array().square().square();
+  return (fourth / (fourth + std::pow(threshold, 4))).matrix();
+}
+
+Matrix6d Degeneracy::priorShare() const {
+  if (threshold <= 0.0) return Matrix6d::Zero();
+  const Vector6d held = Vector6d::Ones() - measuredShares();
   const Vector6d scale = scaling(lever_arm);
-  return scale.cwiseInverse().asDiagonal() * (degenerate * degenerate.transpose()) * scale.asDiagonal();
+  return scale.cwiseInverse().asDiagonal() * (eigenvectors * held.asDiagonal() * eigenvectors.transpose()) *
+         scale.asDiagonal();
 }
 
 Matrix6d Degeneracy::covariance(const Matrix6d& hessian, double measurement_scale, double prior_variance) const {
@@ -84,21 +95,35 @@ std::optional<Degeneracy> analyseDegeneracy(const Matrix6d& hessian, double thre
   if (solver.info() != Eigen::Success) return std::nullopt;
   degeneracy.eigenvalues = solver.eigenvalues();
   degeneracy.eigenvectors = solver.eigenvectors();
+  degeneracy.threshold = threshold;
   while (degeneracy.count < 6 && degeneracy.eigenvalues[degeneracy.count] < threshold) ++degeneracy.count;
   return degeneracy;
 }
 
-std::optional<Vector6d> constrainedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
-                                        const Vector6d& gradient) {
-  if (degeneracy.count == 6) return Vector6d::Zero();
-  const Eigen::LLT<ReducedMatrix> solver(constrainedHessian(degeneracy, hessian));
-  if (solver.info() != Eigen::Success) return std::nullopt;
-  // A gradient scales inversely to a twist: g_s = D^-1 g.
+std::optional<Vector6d> priorWeightedStep(const Degeneracy& degeneracy, const Matrix6d& hessian,
+                                          const Vector6d& gradient, const Vector6d& from_prior) {
+  // In scaled coordinates s = D x (D = diag(1, 1, 1, L, L, L)) the prior adds t V diag(p) V^T to D^-1 H D^-1,
+  // t being H's translation trace, so that its information is a share of the scan's whatever the scene:
+  // p = tau^4 / lambda^3 against the scan's lambda leaves the scan lambda^4 / (lambda^4 + tau^4).
   const Vector6d unscale = scaling(degeneracy.lever_arm).cwiseInverse();
-  const auto constrained = degeneracy.eigenvectors.rightCols(6 - degeneracy.count);
-  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> reduced_gradient =
-      constrained.transpose() * unscale.asDiagonal() * gradient;
-  const Vector6d step = -(unscale.asDiagonal() * (constrained * solver.solve(reduced_gradient)));
+  Matrix6d system = unscale.asDiagonal() * hessian * unscale.asDiagonal();
+  Vector6d right = -(unscale.asDiagonal() * gradient);
+  if (degeneracy.threshold > 0.0) {
+    const double tau_fourth = std::pow(degeneracy.threshold, 4);
+    Vector6d information;
+    for (int i = 0; i < 6; ++i) {
+      const double share = std::max(degeneracy.eigenvalues[i], 0.0);
+      const double cubed = share * share * share;
+      information[i] = cubed * kLargestPriorInformation > tau_fourth ? tau_fourth / cubed : kLargestPriorInformation;
+    }
+    const Matrix6d prior = hessian.topLeftCorner<3, 3>().trace() * degeneracy.eigenvectors *
+                           information.asDiagonal() * degeneracy.eigenvectors.transpose();
+    system += prior;
+    right -= prior * (scaling(degeneracy.lever_arm).asDiagonal() * from_prior);
+  }
+  const Eigen::LDLT<Matrix6d> solver(system);
+  if (solver.info() != Eigen::Success || !(solver.vectorD().array() > 0.0).all()) return std::nullopt;
+  const Vector6d step = unscale.asDiagonal() * solver.solve(right);
   if (!step.allFinite()) return std::nullopt;
   return step;
 }

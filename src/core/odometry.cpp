@@ -174,10 +174,8 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     pose_ = pose_ * result.delta;
     motion_.record(reference_delta, dt);
     const Degeneracy& degeneracy = result.registration.degeneracy;
-    if (degeneracy.any()) {
-      ++degenerate_;
-      motion_.holdVelocityAlong(degeneracy.degenerateProjector());
-    }
+    if (degeneracy.any()) ++degenerate_;
+    motion_.holdVelocityAlong(degeneracy.priorShare());
   }
 
   stage_start = Clock::now();

@@ -66,22 +66,25 @@ bool KernelSchedule::advance(bool step_was_small) {
 
 namespace {
 
-// The directions the registration keeps at the initial guess, decided once per scan from the first
-// iteration's Hessian `weighted` (linearised at the guess); nullopt when the scene constrains no
-// translation or no rotation at all. Keeping them fixed over the iterations keeps the estimate's
-// component along them exactly the guess's (up to the curvature of SE(3)).
+// The prior weighs on a direction whose share is under this many thresholds: it holds 10% of the
+// estimate there (Degeneracy::measuredShares). Above it the weighted Hessian decides alone.
+constexpr double kPriorWeighsBelowThresholds = 3.0;
+
+// The eigen-decomposition that weighs the motion prior against the scan, decided once per scan from the
+// first iteration's Hessian `weighted` (linearised at the guess); nullopt when the scene constrains no
+// translation or no rotation at all. Keeping it over the iterations keeps the prior's information fixed.
 //
 // The robust kernel makes the weighted Hessian depend on how far off the guess is: the correspondences
 // that would pull along a direction the guess has wrong carry large residuals and little weight, so the
 // direction looks degenerate, is kept, stays wrong, and looks degenerate again on the next scan
 // (measured: a drive accelerating along a sparse approach road locked at constant velocity and ended
-// 75 m behind). A flagged direction is therefore confirmed on the geometry alone: the unweighted sums of
-// the same correspondences, within the correspondence gate. That costs one linearisation more, on
-// flagged scans only.
-std::optional<Degeneracy> keptDirections(Backend& backend, const Eigen::Isometry3d& guess, const Matrix6d& weighted,
-                                         double threshold, const RegistrationConfig& config) {
+// 75 m behind). A direction on which the prior weighs is therefore confirmed on the geometry alone: the
+// unweighted sums of the same correspondences, within the correspondence gate. That costs one
+// linearisation more, on those scans only.
+std::optional<Degeneracy> priorDirections(Backend& backend, const Eigen::Isometry3d& guess, const Matrix6d& weighted,
+                                          double threshold, const RegistrationConfig& config) {
   const std::optional<Degeneracy> flagged = analyseDegeneracy(weighted, threshold);
-  if (!flagged || !flagged->any()) return flagged;
+  if (!flagged || !(flagged->eigenvalues[0] < kPriorWeighsBelowThresholds * threshold)) return flagged;
   const NormalEquations geometry = backend.linearize(guess, 0.0);
   Matrix6d hessian;
   Vector6d unused_gradient;
@@ -89,20 +92,21 @@ std::optional<Degeneracy> keptDirections(Backend& backend, const Eigen::Isometry
   return analyseDegeneracy(hessian, threshold);
 }
 
-// The Gauss-Newton step of one iteration within the kept directions, deciding them on the first; nullopt
-// when there is no step to trust: fewer than six constraints, no translation or rotation constraint at
-// all, or a Hessian that is singular within the constrained directions.
+// The Gauss-Newton step of one iteration, weighed against the motion prior `guess` along the weak
+// directions decided on the first; nullopt when there is no step to trust: fewer than six constraints,
+// no translation or rotation constraint at all, or a singular system.
 std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const Vector6d& gradient,
-                                        double degeneracy_threshold, const RegistrationConfig& config,
-                                        RegistrationResult& result) {
+                                        const Eigen::Isometry3d& guess, double degeneracy_threshold,
+                                        const RegistrationConfig& config, RegistrationResult& result) {
   if (result.last.nonground.inliers + result.last.ground.inliers < 6) return std::nullopt;
   if (iteration == 0) {
-    const std::optional<Degeneracy> kept =
-        keptDirections(backend, result.model_from_scan, result.hessian, degeneracy_threshold, config);
-    if (!kept) return std::nullopt;
-    result.degeneracy = *kept;
+    const std::optional<Degeneracy> decided =
+        priorDirections(backend, result.model_from_scan, result.hessian, degeneracy_threshold, config);
+    if (!decided) return std::nullopt;
+    result.degeneracy = *decided;
   }
-  return constrainedStep(result.degeneracy, result.hessian, gradient);
+  return priorWeightedStep(result.degeneracy, result.hessian, gradient,
+                           logSE3(result.model_from_scan * guess.inverse()));
 }
 
 // The size of a Gauss-Newton step: its translation (m) and its rotation (rad).
@@ -149,7 +153,8 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
     result.weight = fusionWeight(result.last, config);
     fuseNormalEquations(result.last, result.weight, result.hessian, g);
     result.iterations = iteration + 1;
-    const std::optional<Vector6d> step = gaussNewtonStep(backend, iteration, g, degeneracy_threshold, config, result);
+    const std::optional<Vector6d> step =
+        gaussNewtonStep(backend, iteration, g, initial_guess, degeneracy_threshold, config, result);
     if (!step) {
       result.failed = true;
       return result;

@@ -62,7 +62,7 @@ std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d
       const Eigen::Isometry3d estimated_motion = relativeMotion(estimate[first], estimate[*last]);
       const Eigen::Isometry3d pose_error = generalInverse(estimated_motion) * gt_motion;
       segments.push_back({first, *last, length, devkitRotationAngle(pose_error) / length,
-                          pose_error.translation().norm() / length});
+                          pose_error.translation().norm() / length, pose_error.translation().head<2>().norm() / length});
     }
   }
   return segments;
@@ -72,18 +72,22 @@ DriftError averageDrift(const std::vector<SegmentError>& segments) {
   DriftError drift;
   drift.segments = segments.size();
   if (segments.empty()) {
-    drift.t_rel_percent = drift.r_rel_deg_per_100m = std::numeric_limits<double>::quiet_NaN();
+    drift.t_rel_percent = drift.r_rel_deg_per_100m = drift.t_rel_horizontal_percent =
+        std::numeric_limits<double>::quiet_NaN();
     return drift;
   }
   double translation_sum = 0.0;
   double rotation_sum = 0.0;
+  double horizontal_sum = 0.0;
   for (const SegmentError& segment : segments) {
     translation_sum += segment.translation_error;
     rotation_sum += segment.rotation_error;
+    horizontal_sum += segment.horizontal_error;
   }
   const double count = static_cast<double>(segments.size());
   drift.t_rel_percent = 100.0 * translation_sum / count;
   drift.r_rel_deg_per_100m = 100.0 * (180.0 / M_PI) * rotation_sum / count;
+  drift.t_rel_horizontal_percent = 100.0 * horizontal_sum / count;
   return drift;
 }
 

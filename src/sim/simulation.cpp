@@ -29,11 +29,23 @@ Route routeFor(const SimulationSpec& spec) {
   return routeFromPoses({spec.driven_poses.begin(), spec.driven_poses.begin() + used}, frame_period);
 }
 
+// The reflection y -> -y, its own inverse.
+Eigen::Isometry3d mirrorOf(const Eigen::Isometry3d& pose) {
+  const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, -1.0, 1.0).asDiagonal();
+  Eigen::Isometry3d mirrored = Eigen::Isometry3d::Identity();
+  mirrored.linear() = flip * pose.linear() * flip;
+  mirrored.translation() = flip * pose.translation();
+  return mirrored;
+}
+
 }  // namespace
 
 Simulation::Simulation(const SimulationSpec& spec)
     : spec_(spec), lidar_(spec.config.sensor, spec.lidar, mixSeed(spec.seed, kCalibrationStream)) {
   if (spec.frames <= 0) throw std::invalid_argument("a simulation needs at least one frame");
+  if (spec.mirrored && !spec.lidar.deskewed && spec.lidar.time_convention == TimeConvention::azimuth) {
+    throw std::invalid_argument("a mirrored drive cannot tell its times by azimuth: the sensor turns the other way");
+  }
   const Route route = routeFor(spec);
   world_ = std::make_unique<World>(spec.world, route,
                                    WorldOptions{spec.seed, spec.config.sensor.max_range + kReachMargin, spec.moving_cars});
@@ -44,7 +56,10 @@ double Simulation::sweepStart(int frame) const { return frame / spec_.config.sen
 
 double Simulation::stamp(int frame) const { return sweepStart(frame) + lidar_.referenceOffset(); }
 
-Eigen::Isometry3d Simulation::sensorPose(int frame) const { return trajectory_->poseAt(stamp(frame)); }
+Eigen::Isometry3d Simulation::sensorPose(int frame) const {
+  const Eigen::Isometry3d pose = trajectory_->poseAt(stamp(frame));
+  return spec_.mirrored ? mirrorOf(pose) : pose;
+}
 
 SimulatedScan Simulation::scan(int frame) const {
   const double start = sweepStart(frame);
@@ -53,8 +68,12 @@ SimulatedScan Simulation::scan(int frame) const {
   const auto snapshot = world_->snapshot(start, pose.translation(), spec_.config.sensor.max_range + kReachMargin);
   // An instantaneous sweep comes without per-point times (Lidar::sweep): the odometry
   // (deskew.time_source field) would move its points by them.
-  return lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
-                      mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
+  SimulatedScan scan = lidar_.sweep(*snapshot, [this](double time) { return trajectory_->poseAt(time); }, start,
+                                    mixSeed(spec_.seed, kNoiseStream, static_cast<uint64_t>(frame)));
+  if (spec_.mirrored) {
+    for (Vec3f& point : scan.cloud.points) point.y() = -point.y();
+  }
+  return scan;
 }
 
 }  // namespace elo::sim

@@ -188,9 +188,11 @@ TEST(ModelUpdate, GroundMapKeepsTheOldestPointOfTheRoadAndExpiresOldOnes) {
   EXPECT_TRUE(fused.vertex[fused.point_of_cell[f.cellOf(kept)]].isApprox(closer));
 }
 
-// Within one scan every point has the same age: of the points of one surface in a cell the lower source
-// (pixel) stays, whatever its noise; the literal rule keeps the nearest.
+// Within one scan every point has the same age: of the points of one surface in a cell the source the
+// hash ranks first stays, whatever its noise or its place (here source 7, the farther point); the literal
+// rule keeps the nearest.
 TEST(ModelUpdate, GroundCellOfOneScanKeepsItsFirstSourceOnTheClosestSurface) {
+  ASSERT_LT(scrambledSource(7), scrambledSource(9));
   Fixture f;
   BevImage map = f.emptyBevMap();
   const Vec3f farther(10.05f, 3.04f, -1.75f);
@@ -236,7 +238,8 @@ TEST(ModelUpdate, GroundMapSlotsFollowEachCellsFirstOffer) {
 // Many offers crowding a few hundred cells, some offered to no cell: up to two threads the fill takes each
 // offer in turn, from three on it groups them by bands of cells first (bev_map.cpp). Both must give the
 // map the rules give, computed here cell by cell: slots in the order of each cell's first offer, each
-// keeping the oldest offer (lowest source among equals) within the surface distance of the closest.
+// keeping the oldest offer (among equals the source the hash ranks first) within the surface distance of
+// the closest.
 TEST(ModelUpdate, GroundMapIsTheRulesMapOnOneThreadAndOnMany) {
   Fixture f;
   constexpr float kSameSurface = 0.3f;
@@ -266,7 +269,8 @@ TEST(ModelUpdate, GroundMapIsTheRulesMapOnOneThreadAndOnMany) {
   for (const cpu::GroundOffer& offer : offers) {
     if (offer.cell < 0 || offer.range > closest[offer.cell] + kSameSurface) continue;
     const cpu::GroundOffer*& best = kept[offer.cell];
-    if (best == nullptr || offer.stamp < best->stamp || (offer.stamp == best->stamp && offer.source < best->source)) {
+    if (best == nullptr || offer.stamp < best->stamp ||
+        (offer.stamp == best->stamp && scrambledSource(offer.source) < scrambledSource(best->source))) {
       best = &offer;
     }
   }

@@ -13,6 +13,7 @@
 #include "analytic_scene.hpp"
 #include "core/common/association.hpp"
 #include "core/common/closest_wins_key.hpp"
+#include "core/common/model_update.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/common/ground.hpp"
 #include "core/common/normals.hpp"
@@ -252,6 +253,23 @@ TEST(PointToPlane, ResidualJacobianAndGemanMcClureWeight) {
 
 // The CPU's 4-wide accumulator adds each packed value the same products in the same order as the shared
 // scalar one, so its sums are the same bit for bit.
+// The model update's second round (model_update.hpp): the older offer wins; equal ages fall to the source
+// a bijective hash ranks first, which each key gives back. Of neighbouring sources (neighbouring columns)
+// either wins about as often: a tie no longer keeps the counter-clockwise point (issue 31).
+TEST(OldestWinsKey, OlderWinsAndEqualAgesFallToAHashOfTheSource) {
+  EXPECT_LT(oldestWinsKey(1.0f, 900000), oldestWinsKey(1.1f, 3));
+  int lower_wins = 0;
+  constexpr uint32_t kPairs = 20000;
+  for (uint32_t source = 0; source < kPairs; ++source) {
+    for (const uint32_t s : {source, ~source, source * 2654435761u}) {
+      ASSERT_EQ(unscrambledSource(scrambledSource(s)), s);
+      ASSERT_EQ(oldestWinsSource(oldestWinsKey(3.5f, s)), s);
+    }
+    if (oldestWinsKey(2.0f, source) < oldestWinsKey(2.0f, source + 1)) ++lower_wins;
+  }
+  EXPECT_NEAR(static_cast<double>(lower_wins) / kPairs, 0.5, 0.02);
+}
+
 TEST(PackedSums, TheCpusLaneSumsEqualTheSharedScalarSumsBitForBit) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f);

@@ -60,6 +60,21 @@ TEST(KittiMetric, ScaledIncrementsOnAStraightLineGiveOnePercent) {
   }
 }
 
+// The horizontal part tells a drift in the plane from one in height: an estimate that climbs 1 cm a metre
+// while the truth drives level has a t_rel of 1% and no horizontal drift; one 1% long along the road has
+// both at 1%.
+TEST(KittiMetric, HorizontalDriftLeavesOutTheHeight) {
+  const std::vector<Eigen::Isometry3d> ground_truth =
+      test::chain(test::translation(Eigen::Vector3d(kSpacing, 0.0, 0.0)), kFrames);  // level, along x
+  std::vector<Eigen::Isometry3d> climbing = ground_truth;
+  for (size_t i = 0; i < climbing.size(); ++i) climbing[i].translation().z() += 0.01 * kSpacing * static_cast<double>(i);
+  const DriftError height = averageDrift(kittiSegmentErrors(ground_truth, climbing));
+  EXPECT_NEAR(height.t_rel_percent, 1.0, 1e-4);
+  EXPECT_NEAR(height.t_rel_horizontal_percent, 0.0, 1e-9);
+  const DriftError along = averageDrift(kittiSegmentErrors(ground_truth, test::scaleIncrements(ground_truth, 1.01)));
+  EXPECT_NEAR(along.t_rel_horizontal_percent, 1.0, 1e-6);
+}
+
 TEST(KittiMetric, ScaledIncrementsOnACircleGiveTheChordError) {
   // On a circle the segment's chord is shorter than its path, and the error is 1% of the chord:
   // 2 R sin(n turn / 2), with R the radius through frames `spacing` apart and n frames in the segment.

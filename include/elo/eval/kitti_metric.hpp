@@ -19,6 +19,9 @@ struct SegmentError {
   double length = 0.0;             // m: the nominal segment length
   double rotation_error = 0.0;     // rad per m
   double translation_error = 0.0;  // m per m
+  // The translation error's x-y part (m per m), in the LiDAR frame of the segment's last scan, where the
+  // devkit's error lies: the drift in the plane, told apart from a drift in height. Not a devkit figure.
+  double horizontal_error = 0.0;
 };
 
 // Mean segment errors in the units the benchmark reports; NaN when there are no segments (a
@@ -27,6 +30,7 @@ struct DriftError {
   size_t segments = 0;
   double t_rel_percent = 0.0;
   double r_rel_deg_per_100m = 0.0;
+  double t_rel_horizontal_percent = 0.0;  // the mean horizontal_error, in %
 };
 
 struct LengthDriftError {

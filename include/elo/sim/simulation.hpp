@@ -25,6 +25,11 @@ struct SimulationSpec {
   Config config;  // the sensor, and ground.sensor_height for its mounting height
   LidarOptions lidar;
   int moving_cars = 0;
+  // The drive in the world's mirror image (y -> -y, seen by a sensor that turns the other way): a left
+  // turn becomes a right one, with the same noise on the mirrored returns. The pipeline owes both the
+  // same drift with the opposite heading error (SparseSensors.*). Not with the azimuth time convention,
+  // whose times are read from the turning direction.
+  bool mirrored = false;
 };
 
 class Simulation {

@@ -6,7 +6,7 @@
 // Which offer a pixel or cell keeps takes two rounds of closest-wins keys (closest_wins_key.hpp). The
 // first finds the closest offer. In the second, the offers on the same surface as the closest one
 // (within model.same_surface_distance of its range) compete by age, and the oldest wins; equal ages, as
-// the points of one scan have, fall to the lower source. A surface in front thus still replaces what it
+// the points of one scan have, fall to a hash of the source. A surface in front thus still replaces what it
 // hides, as the paper's "closer wins" intends, while the noisy ranges of one surface seen again are not
 // filtered for their nearest: which one stays no longer depends on its noise.
 #pragma once
@@ -46,8 +46,34 @@ ELO_HOST_DEVICE inline bool onClosestSurface(float range, float closest_range, f
   return range <= closest_range + same_surface_distance;
 }
 
-// The second round's key: the earliest observation wins, equal stamps fall to the lower source. Stamps
-// count from the first scan and are never negative, so their float bits order like the times.
-ELO_HOST_DEVICE inline ClosestKey oldestWinsKey(float stamp, uint32_t source) { return closestWinsKey(stamp, source); }
+// Equal stamps are the rule, not the exception: the points of one scan that land in one pixel or cell.
+// Which of them stays must not depend on where they lie: "the lower source" (the lower column, the point
+// counter-clockwise of the other) kept the counter-clockwise point of every such pair, and the estimated
+// heading drifted clockwise on every drive, turning left or right (issue 31, docs/accuracy.md). Equal
+// stamps therefore fall to the source that a fixed bijective hash (MurmurHash3's finaliser) ranks first:
+// as deterministic as the index, the same on both backends, and blind to the geometry.
+ELO_HOST_DEVICE inline uint32_t scrambledSource(uint32_t source) {
+  source ^= source >> 16;
+  source *= 0x85ebca6bu;
+  source ^= source >> 13;
+  source *= 0xc2b2ae35u;
+  return source ^ (source >> 16);
+}
+ELO_HOST_DEVICE inline uint32_t unscrambledSource(uint32_t scrambled) {
+  scrambled ^= scrambled >> 16;
+  scrambled *= 0x7ed1b41du;  // the inverse of 0xc2b2ae35 modulo 2^32
+  scrambled ^= (scrambled >> 13) ^ (scrambled >> 26);
+  scrambled *= 0xa5cb9243u;  // the inverse of 0x85ebca6b
+  return scrambled ^ (scrambled >> 16);
+}
+
+// The second round's key: the earliest observation wins, equal stamps fall to the source scrambledSource()
+// ranks first. Stamps count from the first scan and are never negative, so their float bits order like
+// the times.
+ELO_HOST_DEVICE inline ClosestKey oldestWinsKey(float stamp, uint32_t source) {
+  return closestWinsKey(stamp, scrambledSource(source));
+}
+// The source of a second-round key.
+ELO_HOST_DEVICE inline uint32_t oldestWinsSource(ClosestKey key) { return unscrambledSource(closestWinsSource(key)); }
 
 }  // namespace elo

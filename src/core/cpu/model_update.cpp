@@ -72,7 +72,7 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
   });
 
   // Each pixel's winner: the oldest model offer on the closest surface, or the scan's own if it is on
-  // that surface and older (or of the same age and a lower source). Taking the keys empties both rounds
+  // that surface and older (or of the same age and ranked first by the hash). Taking the keys empties both rounds
   // for the next update.
   parallelFor(pixels, [&](size_t pixel) {
     const ClosestKey nearest = closestKey(pixel);
@@ -87,7 +87,7 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
       fused.normal[pixel].setZero();
       return;
     }
-    const uint32_t source = closestWinsSource(winner);
+    const uint32_t source = oldestWinsSource(winner);
     if (isScanSource(source, pixels)) {
       const size_t from = source - pixels;
       fused.vertex[pixel] = observed.vertex[from];

@@ -173,7 +173,7 @@ __global__ void writeWinners(Sources offered, CellCompaction compaction, DeviceB
     if (tile == tiles - 1 && threadIdx.x == 0) *map.count = tile_slot + tile_firsts;
     if (first == 0) continue;
     const int cell = compaction.source_cells[source];
-    const uint32_t winner = closestWinsSource(compaction.surface_keys[cell]);
+    const uint32_t winner = oldestWinsSource(compaction.surface_keys[cell]);
     const int slot = tile_slot + slot_in_tile;
     const Float3 vertex = sources.vertex(winner);
     map.cells[slot] = cell;

@@ -69,7 +69,7 @@ __global__ void takeFusedWinners(ClosestKey* closest_keys, ClosestKey* surface_k
     return;
   }
   const uint32_t pixels = static_cast<uint32_t>(fused.pixels());
-  const uint32_t source = closestWinsSource(key);
+  const uint32_t source = oldestWinsSource(key);
   if (isScanSource(source, pixels)) {
     const uint32_t from = source - pixels;
     fused.vertices[pixel] = scan.vertices[from];

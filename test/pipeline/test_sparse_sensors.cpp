@@ -1,0 +1,99 @@
+// Sparse sensors (issue 31) on a simulated urban drive, the sensor configured by its config/<sensor>.yaml:
+// the heading error's sign, the horizontal drift and the heading slip. A drive and its mirror image (left
+// turns made right ones) must drift in heading by opposite amounts, so that their mean per-scan heading
+// error, the pipeline's one-signed part, is near zero. A short drive, run in every test run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "elo/eval/evaluation.hpp"
+#include "elo/odometry.hpp"
+#include "elo/sim/sensors.hpp"
+#include "elo/sim/simulation.hpp"
+
+namespace elo {
+namespace {
+
+constexpr double kDegrees = 180.0 / M_PI;
+
+double yawOf(const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); }
+
+struct SparseDrive {
+  TrajectoryEvaluation evaluation;
+  double mean_heading_drift_deg = 0.0;  // per scan: the estimated increment's yaw minus the truth's
+  double largest_slip_deg = 0.0;        // the largest heading change against the truth over any 10 scans
+  double turned_deg = 0.0;              // the truth's heading change over the drive
+};
+
+// The odometry, configured as config/<sensor>.yaml, over the simulated drive of that sensor.
+SparseDrive drive(const std::string& sensor, sim::SimulationSpec spec) {
+  sim::loadSensor(sensor, spec.config);
+  const sim::Simulation simulation(spec);
+  Odometry odometry(spec.config);
+  std::vector<Eigen::Isometry3d> truth;
+  std::vector<Eigen::Isometry3d> estimate;
+  const Eigen::Isometry3d start = simulation.sensorPose(0);
+  for (int frame = 0; frame < simulation.frameCount(); ++frame) {
+    const FrameResult result = odometry.process(simulation.scan(frame).cloud);
+    EXPECT_TRUE(result.processed) << sensor << ", frame " << frame << ": " << result.skip_reason;
+    truth.push_back(start.inverse() * simulation.sensorPose(frame));
+    estimate.push_back(result.pose);
+  }
+  SparseDrive result;
+  result.evaluation = evaluateTrajectory(sensor, truth, estimate);
+  std::vector<double> heading_error;
+  for (size_t i = 0; i < truth.size(); ++i) heading_error.push_back(yawOf(truth[i].inverse() * estimate[i]));
+  constexpr size_t kSlipScans = 10;
+  for (size_t i = 0; i + kSlipScans < truth.size(); ++i) {
+    result.largest_slip_deg =
+        std::max(result.largest_slip_deg, kDegrees * std::abs(heading_error[i + kSlipScans] - heading_error[i]));
+  }
+  for (size_t i = 1; i < truth.size(); ++i) {
+    const Eigen::Isometry3d true_increment = truth[i - 1].inverse() * truth[i];
+    const Eigen::Isometry3d increment = estimate[i - 1].inverse() * estimate[i];
+    result.mean_heading_drift_deg += kDegrees * yawOf(true_increment.inverse() * increment);
+    result.turned_deg += kDegrees * yawOf(true_increment);
+  }
+  result.mean_heading_drift_deg /= static_cast<double>(truth.size() - 1);
+  const DriftError& drift = result.evaluation.drift;
+  std::cout << sensor << (spec.mirrored ? " mirrored" : "") << ", " << simulation.frameCount() << " scans, "
+            << result.evaluation.length_m << " m, turned " << result.turned_deg << " deg: t_rel "
+            << drift.t_rel_percent << " %, horizontal " << drift.t_rel_horizontal_percent << " %, r_rel "
+            << drift.r_rel_deg_per_100m << " deg/100m, heading drift " << result.mean_heading_drift_deg
+            << " deg/scan, largest slip over 10 scans " << result.largest_slip_deg << " deg" << std::endl;
+  return result;
+}
+
+sim::SimulationSpec urbanCurves(int frames, uint64_t seed, bool mirrored = false) {
+  sim::SimulationSpec spec;
+  spec.world = sim::WorldFamily::urban;
+  spec.trajectory = sim::TrajectoryKind::curves;
+  spec.frames = frames;
+  spec.seed = seed;
+  spec.mirrored = mirrored;
+  return spec;
+}
+
+// 200 VLP-16 scans (166 m, turning 45 degrees) and their mirror image. Until the model update's equal-age
+// offers fell to the lower column, both drifted clockwise: -0.00100 and -0.00121 deg/scan (pair mean
+// -0.0011); measured since (with the fading prior of degeneracy.hpp too): +0.000123 and -0.000118 (pair
+// mean +0.000003), horizontal t_rel 0.036 % both (0.100 and 0.094 before), largest slip over 10 scans
+// 0.035 deg.
+TEST(SparseSensors, HeadingDriftHasNoSignTurningLeftOrRight) {
+  const SparseDrive left = drive("vlp16", urbanCurves(200, 3));
+  const SparseDrive right = drive("vlp16", urbanCurves(200, 3, true));
+  EXPECT_GT(left.turned_deg, 40.0);
+  EXPECT_LT(right.turned_deg, -40.0);
+  EXPECT_LT(std::abs(0.5 * (left.mean_heading_drift_deg + right.mean_heading_drift_deg)), 0.0003);
+  for (const SparseDrive* run : {&left, &right}) {
+    EXPECT_LT(run->evaluation.drift.t_rel_horizontal_percent, 0.06);
+    EXPECT_LT(run->largest_slip_deg, 0.5);
+  }
+}
+
+}  // namespace
+}  // namespace elo
