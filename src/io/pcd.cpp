@@ -43,8 +43,8 @@ double readScalar(const uint8_t* bytes, uint8_t datatype) {
     case PCLPointField::UINT16: return readAs<uint16_t>(bytes);
     case PCLPointField::INT32: return readAs<int32_t>(bytes);
     case PCLPointField::UINT32: return readAs<uint32_t>(bytes);
-    case PCLPointField::INT64: return readAs<int64_t>(bytes);
-    case PCLPointField::UINT64: return readAs<uint64_t>(bytes);
+    case io_detail::kPcdInt64: return readAs<int64_t>(bytes);
+    case io_detail::kPcdUint64: return readAs<uint64_t>(bytes);
     case PCLPointField::FLOAT32: return readAs<float>(bytes);
     case PCLPointField::FLOAT64: return readAs<double>(bytes);
     default: return readAs<uint8_t>(bytes);  // BOOL: one byte
