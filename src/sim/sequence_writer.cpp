@@ -1,13 +1,19 @@
 #include "elo/sim/sequence_writer.hpp"
 
-#include <tbb/task_arena.h>  // first: it defines TBB_VERSION_MAJOR in TBB 2020 and oneTBB alike
-// oneTBB (2021 on) has the pipeline in its own header, the filter modes in tbb::filter_mode; TBB 2020
-// (Noetic, Debian 11) in tbb/pipeline.h, the modes in tbb::filter.
+// TBB_VERSION_MAJOR: oneTBB (2021 on) defines it in tbb/version.h, TBB 2020 (Noetic, Debian 11) in
+// tbb/tbb_stddef.h. oneTBB has the pipeline in its own header and the filter modes in tbb::filter_mode;
+// TBB 2020 in tbb/pipeline.h, the modes in tbb::filter.
+#if __has_include(<tbb/version.h>)
+#include <tbb/version.h>
+#else
+#include <tbb/tbb_stddef.h>
+#endif
 #if TBB_VERSION_MAJOR >= 2021
 #include <tbb/parallel_pipeline.h>
 #else
 #include <tbb/pipeline.h>
 #endif
+#include <tbb/task_arena.h>
 
 #include <cstdio>
 #include <filesystem>
