@@ -66,6 +66,8 @@ mount_into /sys -t sysfs sysfs
 mount_into /dev --bind /dev
 mount_into /dev/pts --bind /dev/pts
 $sudo cp /etc/resolv.conf "$chroot_dir/etc/resolv.conf"
+# debootstrap writes no /etc/hosts, and roslaunch must resolve localhost.
+grep -qs localhost "$chroot_dir/etc/hosts" || printf '127.0.0.1 localhost\n::1 localhost\n' | $sudo tee -a "$chroot_dir/etc/hosts" >/dev/null
 if [ -d "$shared" ]; then
   mount_into /src/shared/data --bind "$shared"
   $sudo mount -o remount,ro,bind "$chroot_dir/src/shared/data"

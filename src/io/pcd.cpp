@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
@@ -191,6 +192,15 @@ void writePcd(const std::string& path, const PointCloud& cloud) {
     writeScalar(point, pcd.fields[3], cloud.intensity.empty() ? 0.0f : cloud.intensity[i]);
     if (has_ring) writeScalar(point, pcd.fields[4], cloud.ring[i]);
     if (has_time) writeScalar(point, pcd.fields.back(), cloud.time[i]);
+  }
+  if (cloud.size() == 0) {
+    // PCL 1.11 (Debian 11) refuses to write a cloud without points; PCL 1.13 writes its header and an
+    // empty binary DATA section, as this does for every PCL (docs/platforms.md).
+    std::ofstream stream = io_detail::openForWriting(path, std::ios::binary);
+    stream << pcl::PCDWriter().generateHeaderBinary(pcd, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity())
+           << "DATA binary\n";
+    io_detail::finishWriting(stream, path);
+    return;
   }
   if (pcl::io::savePCDFile(path, pcd, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true) != 0) {
     throw IoError("cannot write '" + path + "'");
