@@ -22,7 +22,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
 
-.PHONY: deps build test test-long test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
+.PHONY: deps build test test-long compat test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -94,6 +94,13 @@ bench: build
 # (tools/gpu_check.sh; docs/cuda.md says how to run it from a build packed for a machine without ROS).
 gpu-check: build
 	tools/gpu_check.sh $(BUILD)/devel/lib/elo_odometry $(SHARED_DATA)/real/hdl64_drive_a
+
+# The package built and tested on Debian 11 (bullseye, the nearest twin of Noetic's Ubuntu 20.04) in a
+# debootstrap chroot cached in .compat/ (tools/compat.sh; root or sudo). COMPAT_TARGETS=core builds
+# everything and runs the core tests only, as CI does.
+COMPAT_TARGETS ?= test
+compat:
+	tools/compat.sh $(COMPAT_TARGETS)
 
 # The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth, then
 # replayed from a bag through the ROS node. DEMO_FRAMES=60 makes it short; see tools/demo.sh.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
@@ -43,8 +44,8 @@ double readScalar(const uint8_t* bytes, uint8_t datatype) {
     case PCLPointField::UINT16: return readAs<uint16_t>(bytes);
     case PCLPointField::INT32: return readAs<int32_t>(bytes);
     case PCLPointField::UINT32: return readAs<uint32_t>(bytes);
-    case PCLPointField::INT64: return readAs<int64_t>(bytes);
-    case PCLPointField::UINT64: return readAs<uint64_t>(bytes);
+    case io_detail::kPcdInt64: return readAs<int64_t>(bytes);
+    case io_detail::kPcdUint64: return readAs<uint64_t>(bytes);
     case PCLPointField::FLOAT32: return readAs<float>(bytes);
     case PCLPointField::FLOAT64: return readAs<double>(bytes);
     default: return readAs<uint8_t>(bytes);  // BOOL: one byte
@@ -84,6 +85,15 @@ std::string readFileBytes(const std::string& path) {
 }
 
 void savePcd(const std::string& path, const pcl::PCLPointCloud2& cloud) {
+  if (cloud.width * cloud.height == 0) {
+    // PCL 1.11 (Debian 11) refuses to write a cloud without points; PCL 1.13 writes its header and an
+    // empty binary DATA section, as this does for every PCL (docs/platforms.md).
+    std::ofstream stream = openForWriting(path, std::ios::binary);
+    stream << pcl::PCDWriter().generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity())
+           << "DATA binary\n";
+    finishWriting(stream, path);
+    return;
+  }
   if (pcl::io::savePCDFile(path, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true) != 0) {
     throw IoError("cannot write '" + path + "'");
   }

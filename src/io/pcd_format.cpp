@@ -136,11 +136,11 @@ uint8_t datatypeOf(const std::string& type, uint64_t size) {
   if (type == "I" && size == 1) return PCLPointField::INT8;
   if (type == "I" && size == 2) return PCLPointField::INT16;
   if (type == "I" && size == 4) return PCLPointField::INT32;
-  if (type == "I" && size == 8) return PCLPointField::INT64;
+  if (type == "I" && size == 8) return kPcdInt64;
   if (type == "U" && size == 1) return PCLPointField::UINT8;
   if (type == "U" && size == 2) return PCLPointField::UINT16;
   if (type == "U" && size == 4) return PCLPointField::UINT32;
-  if (type == "U" && size == 8) return PCLPointField::UINT64;
+  if (type == "U" && size == 8) return kPcdUint64;
   if (type == "F" && size == 4) return PCLPointField::FLOAT32;
   if (type == "F" && size == 8) return PCLPointField::FLOAT64;
   return 0;
@@ -298,11 +298,11 @@ bool storeWord(const std::string& word, uint8_t datatype, uint8_t* destination) 
     case PCLPointField::INT8: return storeWord<int8_t>(word, destination);
     case PCLPointField::INT16: return storeWord<int16_t>(word, destination);
     case PCLPointField::INT32: return storeWord<int32_t>(word, destination);
-    case PCLPointField::INT64: return storeWord<int64_t>(word, destination);
+    case kPcdInt64: return storeWord<int64_t>(word, destination);
     case PCLPointField::UINT8: return storeWord<uint8_t>(word, destination);
     case PCLPointField::UINT16: return storeWord<uint16_t>(word, destination);
     case PCLPointField::UINT32: return storeWord<uint32_t>(word, destination);
-    case PCLPointField::UINT64: return storeWord<uint64_t>(word, destination);
+    case kPcdUint64: return storeWord<uint64_t>(word, destination);
     case PCLPointField::FLOAT32: return storeWord<float>(word, destination);
     default: return storeWord<double>(word, destination);  // buildFields admits no other type
   }

@@ -7,6 +7,7 @@
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/PCLPointField.h>
+#include <pcl/pcl_config.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +16,17 @@
 #include <vector>
 
 namespace elo::io_detail {
+
+// The datatypes of 64-bit integer fields. PCL names them from 1.13 (PCLPointField::INT64, UINT64); older
+// PCL (1.10 on Noetic, 1.12 on Ubuntu 22.04) has no such datatype, and the fields of a parsed PCD live
+// only in this reader's PcdPoints, so it names them itself, with the numbers PCL 1.13 gives them.
+#if PCL_VERSION_COMPARE(>=, 1, 13, 0)
+constexpr uint8_t kPcdInt64 = pcl::PCLPointField::INT64;
+constexpr uint8_t kPcdUint64 = pcl::PCLPointField::UINT64;
+#else
+constexpr uint8_t kPcdInt64 = 9;
+constexpr uint8_t kPcdUint64 = 10;
+#endif
 
 struct PcdPoints {
   std::vector<pcl::PCLPointField> fields;  // offset, datatype and count of each field within a point

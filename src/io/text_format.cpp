@@ -2,8 +2,10 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "elo/io/io_error.hpp"
@@ -33,11 +35,25 @@ void finishWriting(std::ofstream& stream, const std::string& path) {
   }
 }
 
+// std::to_chars for double comes with libstdc++ 11 (__cpp_lib_to_chars); GCC 9 and 10 (Noetic, Debian 11)
+// have it for integers only. There the shortest %g precision that reads back as the same double does:
+// the same digits, though where the exponent starts may differ.
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
 std::string formatDouble(double value) {
   char buffer[32];
   const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
   return std::string(buffer, result.ptr);
 }
+#else
+std::string formatDouble(double value) {
+  char buffer[32];
+  for (int precision = 1;; ++precision) {
+    std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
+    if (precision == std::numeric_limits<double>::max_digits10 || std::strtod(buffer, nullptr) == value) break;
+  }
+  return buffer;
+}
+#endif
 
 std::string formatDoubles(const std::vector<double>& values) {
   std::string text;

@@ -1,6 +1,18 @@
 #include "elo/sim/sequence_writer.hpp"
 
+// TBB_VERSION_MAJOR: oneTBB (2021 on) defines it in tbb/version.h, TBB 2020 (Noetic, Debian 11) in
+// tbb/tbb_stddef.h. oneTBB has the pipeline in its own header and the filter modes in tbb::filter_mode;
+// TBB 2020 in tbb/pipeline.h, the modes in tbb::filter.
+#if __has_include(<tbb/version.h>)
+#include <tbb/version.h>
+#else
+#include <tbb/tbb_stddef.h>
+#endif
+#if TBB_VERSION_MAJOR >= 2021
 #include <tbb/parallel_pipeline.h>
+#else
+#include <tbb/pipeline.h>
+#endif
 #include <tbb/task_arena.h>
 
 #include <cstdio>
@@ -14,6 +26,12 @@
 
 namespace elo::sim {
 namespace {
+
+#if TBB_VERSION_MAJOR >= 2021
+using FilterMode = tbb::filter_mode;
+#else
+using FilterMode = tbb::filter;
+#endif
 
 std::filesystem::path scanDirectory(const std::filesystem::path& root, ScanFormat format) {
   return format == ScanFormat::kitti_bin ? root / "velodyne" : root;
@@ -55,18 +73,18 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
   const size_t in_flight = 2 * static_cast<size_t>(tbb::this_task_arena::max_concurrency());
   tbb::parallel_pipeline(
       in_flight,
-      tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
+      tbb::make_filter<void, int>(FilterMode::serial_in_order,
                                   [&](tbb::flow_control& control) {
                                     if (next == frames) control.stop();
                                     return next++;
                                   }) &
-          tbb::make_filter<int, Frame>(tbb::filter_mode::parallel,
+          tbb::make_filter<int, Frame>(FilterMode::parallel,
                                        [&](int frame) {
                                          auto scan = std::make_shared<const SimulatedScan>(simulation.scan(frame));
                                          writeScan(scans, format, frame, scan->cloud);
                                          return Frame{frame, std::move(scan)};
                                        }) &
-          tbb::make_filter<Frame, void>(tbb::filter_mode::serial_in_order, [&](const Frame& frame) {
+          tbb::make_filter<Frame, void>(FilterMode::serial_in_order, [&](const Frame& frame) {
             poses[frame.index] = frame.index == 0 ? Eigen::Isometry3d::Identity()  // exactly, not up to rounding
                                                   : first_inverse * simulation.sensorPose(frame.index);
             stamps[frame.index] = simulation.stamp(frame.index);

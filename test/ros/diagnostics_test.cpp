@@ -83,7 +83,7 @@ TEST(RosDiagnostics, UnusablePerPointTimesWarnAndAreCountedByReason) {
 TEST(RosDiagnostics, DegenerateScansWarnWhileTheyLastAndAreCounted) {
   elo_ros::PipelineStatistics statistics;
   elo::FrameResult tunnel = processedScan(60.0);
-  elo::Matrix6d hessian = elo::Vector6d(0, 1, 1, 50, 50, 50).asDiagonal();  // x unconstrained
+  elo::Matrix6d hessian = (elo::Vector6d() << 0, 1, 1, 50, 50, 50).finished().asDiagonal();  // x unconstrained
   tunnel.registration.degeneracy = *elo::analyseDegeneracy(hessian, 0.005);
   statistics.cloudReceived();
   statistics.scanProcessed(tunnel, 65.0);

@@ -91,7 +91,7 @@ TEST(RosMessages, ModelPointsMoveIntoTheOdomFrame) {
 
 elo::RegistrationResult registration(double nonground_error, double ground_error) {
   elo::RegistrationResult result;
-  result.hessian = elo::Vector6d(1, 2, 4, 8, 16, 32).asDiagonal();
+  result.hessian = (elo::Vector6d() << 1, 2, 4, 8, 16, 32).finished().asDiagonal();
   result.weight = 0.5;
   result.last.nonground.inliers = 300;
   result.last.nonground.squared_error = nonground_error;
@@ -104,8 +104,8 @@ TEST(RosMessages, CovarianceIsTheScaledInverseHessian) {
   // Residual variance 0.5 * 3/300 + 0.5 * 2/100 = 0.015, over 400 inliers.
   const auto covariance = elo_ros::registrationCovariance(registration(3.0, 2.0));
   ASSERT_TRUE(covariance.has_value());
-  const elo::Matrix6d expected =
-      (0.015 / 400.0) * elo::Vector6d(1, 0.5, 0.25, 0.125, 0.0625, 0.03125).asDiagonal().toDenseMatrix();
+  const elo::Vector6d inverse_diagonal = (elo::Vector6d() << 1, 0.5, 0.25, 0.125, 0.0625, 0.03125).finished();
+  const elo::Matrix6d expected = (0.015 / 400.0) * inverse_diagonal.asDiagonal().toDenseMatrix();
   EXPECT_LT(largestDifference(*covariance, expected), 1e-15) << *covariance;
 
   elo::RegistrationResult failed = registration(3.0, 2.0);
@@ -125,7 +125,8 @@ TEST(RosMessages, DegenerateDirectionsGetTheLargeVarianceOfThePrior) {
   ASSERT_TRUE(covariance.has_value()) << "a degenerate scan still has a covariance";
   EXPECT_NEAR((*covariance)(0, 0), 1.0, 1e-12) << "(1 m)^2 along the degenerate direction";
   // The constrained directions keep the scaled inverse Hessian, with no correlation to x.
-  const elo::Vector6d constrained = (0.015 / 400.0) * elo::Vector6d(0, 0.5, 0.25, 0.125, 0.0625, 0.03125);
+  const elo::Vector6d constrained =
+      (0.015 / 400.0) * (elo::Vector6d() << 0, 0.5, 0.25, 0.125, 0.0625, 0.03125).finished();
   EXPECT_LT((covariance->diagonal().tail<5>() - constrained.tail<5>()).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_LT(covariance->row(0).tail<5>().cwiseAbs().maxCoeff(), 1e-15);
 }

@@ -6,7 +6,13 @@
 // and writes the totals straight into the host's pinned memory: no second kernel and no copy. The
 // grid is fixed (kReductionBlocks per term) and no floating-point value goes through an atomic, so the
 // sums are the same on every run and every GPU.
+// cuda::atomic_ref comes with CUDA 11.6, on float with CUDA 12.0 (JetPack 5 has 11.4). Before 12, or
+// with ELO_CUDA_LEGACY_FALLBACKS (which lets a GPU machine with a newer toolkit test them), the accesses
+// below are volatile ones and fences, as CUDA's memory model guide gives them (docs/platforms.md).
+#if __CUDACC_VER_MAJOR__ >= 12 && !defined(ELO_CUDA_LEGACY_FALLBACKS)
+#define ELO_CUDA_ATOMIC_REF 1
 #include <cuda/atomic>
+#endif
 
 #include "core/common/point_to_plane.hpp"
 #include "core/cuda/kernels.hpp"
@@ -26,6 +32,7 @@ constexpr int kRowsPerWarp = (kTotalRows + kWarps - 1) / kWarps;
 static_assert(kReductionBlocks % 32 == 0, "a warp adds a row of partials, every lane as many");
 static_assert(kPartialRows <= kThreads, "a block writes each of its partial's rows with one thread");
 
+#ifdef ELO_CUDA_ATOMIC_REF
 __device__ float relaxedLoad(float& value) {
   return ::cuda::atomic_ref<float, ::cuda::thread_scope_device>(value).load(::cuda::memory_order_relaxed);
 }
@@ -33,6 +40,33 @@ __device__ float relaxedLoad(float& value) {
 __device__ void relaxedStore(float& target, float value) {
   ::cuda::atomic_ref<float, ::cuda::thread_scope_device>(target).store(value, ::cuda::memory_order_relaxed);
 }
+
+__device__ unsigned acquireLoad(unsigned& value) {
+  return ::cuda::atomic_ref<unsigned, ::cuda::thread_scope_device>(value).load(::cuda::memory_order_acquire);
+}
+
+__device__ void releaseStore(unsigned& target, unsigned value) {
+  ::cuda::atomic_ref<unsigned, ::cuda::thread_scope_device>(target).store(value, ::cuda::memory_order_release);
+}
+#else
+// An aligned 32-bit volatile access is one untorn load or store that bypasses no other thread's write
+// (ld.volatile / st.volatile): a relaxed atomic. The fence after the acquiring load keeps every later
+// read after it; the fence before the releasing store keeps every earlier write before it, device-wide.
+__device__ float relaxedLoad(float& value) { return *const_cast<volatile float*>(&value); }
+
+__device__ void relaxedStore(float& target, float value) { *const_cast<volatile float*>(&target) = value; }
+
+__device__ unsigned acquireLoad(unsigned& value) {
+  const unsigned loaded = *const_cast<volatile unsigned*>(&value);
+  __threadfence();
+  return loaded;
+}
+
+__device__ void releaseStore(unsigned& target, unsigned value) {
+  __threadfence();
+  *const_cast<volatile unsigned*>(&target) = value;
+}
+#endif
 
 struct ThreadSums {
   double values[kTermValues];
@@ -91,16 +125,16 @@ __device__ void addNongroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
 // acquired.
 __device__ Float3 cachedGroundNormal(const LinearizeInputs& in, int32_t match) {
   const GroundNormalCache& cache = in.ground_normals;
-  ::cuda::atomic_ref<unsigned, ::cuda::thread_scope_device> epoch(cache.epochs[match]);
+  unsigned& epoch = cache.epochs[match];
   float* stored = &cache.normals[match].x;
-  if (epoch.load(::cuda::memory_order_acquire) == cache.epoch) {
+  if (acquireLoad(epoch) == cache.epoch) {
     return {relaxedLoad(stored[0]), relaxedLoad(stored[1]), relaxedLoad(stored[2])};
   }
   const Float3 normal = groundNormal(in.model_ground, in.bev, match, in.normal_neighbours, in.patch_radius);
   relaxedStore(stored[0], normal.x);
   relaxedStore(stored[1], normal.y);
   relaxedStore(stored[2], normal.z);
-  epoch.store(cache.epoch, ::cuda::memory_order_release);
+  releaseStore(epoch, cache.epoch);
   return normal;
 }
 

@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# Builds and tests the package on Debian 11 (bullseye: GCC 10, CMake 3.18, TBB 2020, PCL 1.11, roscpp 1.15
+# as on Noetic), in a chroot made with debootstrap, from a clean copy of this tree (what git tracks or
+# would track: no build directories), with the `make deps` and `make` targets a user runs. Root only (it
+# mounts; sudo is used when not root). Usage:
+#   tools/compat.sh [MAKE_TARGET... | core]
+# MAKE_TARGET defaults to `test`. `core` builds everything and runs the core tests only (ctest -L core):
+# CI's share of the run. Environment: COMPAT_CACHE (default .compat/ in the tree, ignored by git: the
+# chroot, kept between runs so that a second run needs no download), COMPAT_MIRROR (default Debian's,
+# deb.debian.org), JOBS (default nproc). The shared data (../shared/data) is mounted read-only when present.
+set -euo pipefail
+tree="$(cd "$(dirname "$0")/.." && pwd)"
+cache=${COMPAT_CACHE:-$tree/.compat}
+mirror=${COMPAT_MIRROR:-http://deb.debian.org/debian}
+jobs=${JOBS:-$(nproc)}
+chroot_dir="$cache/bullseye"
+src="/src/elo_odometry"  # the tree's copy, inside the chroot; ../shared/data beside it as in a checkout
+shared="$tree/../shared/data"
+targets=("${@:-test}")
+sudo=""
+[ "$(id -u)" = 0 ] || sudo=sudo
+
+step() {
+  echo "=== compat: $* (at ${SECONDS} s)"
+}
+
+# The base system, once: debootstrap into a temporary directory and rename it when complete, so that an
+# interrupted run leaves no half-made chroot behind to be taken for a cached one.
+if [ ! -x "$chroot_dir/usr/bin/apt-get" ]; then
+  command -v debootstrap >/dev/null || $sudo apt-get -o DPkg::Lock::Timeout=900 install -y -qq debootstrap
+  step "debootstrap bullseye from $mirror into $chroot_dir"
+  $sudo rm -rf "$chroot_dir.partial"
+  mkdir -p "$cache"
+  $sudo debootstrap --variant=minbase --include=make bullseye "$chroot_dir.partial" "$mirror"
+  # A throwaway system: no fsync per file, no manuals or recommended extras (make deps names every
+  # package the build and the tests need): apt takes less time in it.
+  echo force-unsafe-io | $sudo tee "$chroot_dir.partial/etc/dpkg/dpkg.cfg.d/90elo-unsafe-io" >/dev/null
+  printf 'path-exclude=/usr/share/%s/*\n' doc man info locale | $sudo tee "$chroot_dir.partial/etc/dpkg/dpkg.cfg.d/90elo-no-docs" >/dev/null
+  echo 'APT::Install-Recommends "false";' | $sudo tee "$chroot_dir.partial/etc/apt/apt.conf.d/90elo-no-recommends" >/dev/null
+  $sudo mv "$chroot_dir.partial" "$chroot_dir"
+fi
+
+# The chroot holds bullseye's ROS packages: catkin and rospack, which crawl the source tree (and a
+# workspace's src/), must not take them for packages of the workspace.
+touch "$cache/CATKIN_IGNORE" "$cache/rospack_nosubdirs"
+
+# Mounts for the run, undone on any exit, in reverse order; the shared data read-only, so that nothing in
+# the chroot can change it.
+mounted=()
+cleanup() {
+  local i
+  for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do
+    $sudo umount "${mounted[i]}" || $sudo umount -l "${mounted[i]}" || true
+  done
+}
+trap cleanup EXIT
+mount_into() {  # mount_into TARGET_IN_CHROOT MOUNT_ARGS...
+  local target="$chroot_dir$1"
+  shift
+  $sudo mkdir -p "$target"
+  $sudo mount "$@" "$target"
+  mounted+=("$target")
+}
+mount_into /proc -t proc proc
+mount_into /sys -t sysfs sysfs
+mount_into /dev --bind /dev
+mount_into /dev/pts --bind /dev/pts
+$sudo cp /etc/resolv.conf "$chroot_dir/etc/resolv.conf"
+# debootstrap writes no /etc/hosts, and roslaunch must resolve localhost.
+grep -qs localhost "$chroot_dir/etc/hosts" || printf '127.0.0.1 localhost\n::1 localhost\n' | $sudo tee -a "$chroot_dir/etc/hosts" >/dev/null
+if [ -d "$shared" ]; then
+  mount_into /src/shared/data --bind "$shared"
+  $sudo mount -o remount,ro,bind "$chroot_dir/src/shared/data"
+fi
+
+step "copy the tree to $src"
+$sudo rm -rf "$chroot_dir$src"
+$sudo mkdir -p "$chroot_dir$src"
+# Tracked and untracked-but-not-ignored files as they are now; a tracked file deleted here is left out.
+(cd "$tree" && git ls-files -z --cached --others --exclude-standard |
+  xargs -0 -I{} sh -c 'test -e "$1" && printf "%s\0" "$1"' _ {} |
+  tar --null -T - -cf -) | $sudo tar -xf - -C "$chroot_dir$src"
+
+# COMMAND in the tree's copy, in a clean environment. With --isolated, in a network namespace of its own
+# with only loopback, where the kernel allows one, so that the tests' ROS masters meet no other on this
+# machine (ROS_HOSTNAME=localhost: the one name there is). ccache is used where the chroot has it
+# (installed by hand for quick local re-runs; CI's chroot has none).
+in_chroot() {  # in_chroot [--isolated] COMMAND
+  local isolate=()
+  if [ "$1" = --isolated ]; then
+    shift
+    if command -v ip >/dev/null && $sudo unshare --net true 2>/dev/null; then
+      isolate=(unshare --net sh -c 'ip link set lo up && exec "$@"' _)
+    fi
+  fi
+  local launcher=""
+  [ -x "$chroot_dir/usr/bin/ccache" ] && launcher=ccache
+  $sudo "${isolate[@]}" chroot "$chroot_dir" env -i HOME=/root LANG=C.UTF-8 TERM=dumb ROS_HOSTNAME=localhost \
+    PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin ${launcher:+CMAKE_CXX_COMPILER_LAUNCHER=$launcher} \
+    bash -c "cd $src && $1"
+}
+
+step "make deps (installs what bullseye lacks; nothing on a cached chroot)"
+in_chroot "apt-get update -qq && make deps"
+
+if [ "${targets[*]}" = core ]; then
+  step "make build, then ctest -L core"
+  in_chroot --isolated "make build JOBS=$jobs && cd build && ctest --output-on-failure -L core -j$jobs"
+else
+  step "make ${targets[*]}"
+  in_chroot --isolated "make ${targets[*]} JOBS=$jobs"
+fi
+step "done: Debian 11 passed"
