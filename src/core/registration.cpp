@@ -78,11 +78,11 @@ namespace {
 // 75 m behind). A flagged direction is therefore confirmed on the geometry alone: the unweighted sums of
 // the same correspondences, within the correspondence gate. That costs one linearisation more, on
 // flagged scans only.
-std::optional<Degeneracy> keptDirections(Backend& backend, const Eigen::Isometry3d& guess, const Matrix6d& weighted,
-                                         double threshold, const RegistrationConfig& config) {
+std::optional<Degeneracy> keptDirections(const Linearize& linearize, const Eigen::Isometry3d& guess,
+                                         const Matrix6d& weighted, double threshold, const RegistrationConfig& config) {
   const std::optional<Degeneracy> flagged = analyseDegeneracy(weighted, threshold);
   if (!flagged || !flagged->any()) return flagged;
-  const NormalEquations geometry = backend.linearize(guess, 0.0);
+  const NormalEquations geometry = linearize(guess, 0.0);
   Matrix6d hessian;
   Vector6d unused_gradient;
   fuseNormalEquations(geometry, fusionWeight(geometry, config), hessian, unused_gradient);
@@ -92,13 +92,13 @@ std::optional<Degeneracy> keptDirections(Backend& backend, const Eigen::Isometry
 // The Gauss-Newton step of one iteration within the kept directions, deciding them on the first; nullopt
 // when there is no step to trust: fewer than six constraints, no translation or rotation constraint at
 // all, or a Hessian that is singular within the constrained directions.
-std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const Vector6d& gradient,
+std::optional<Vector6d> gaussNewtonStep(const Linearize& linearize, int iteration, const Vector6d& gradient,
                                         double degeneracy_threshold, const RegistrationConfig& config,
                                         RegistrationResult& result) {
   if (result.last.nonground.inliers + result.last.ground.inliers < 6) return std::nullopt;
   if (iteration == 0) {
     const std::optional<Degeneracy> kept =
-        keptDirections(backend, result.model_from_scan, result.hessian, degeneracy_threshold, config);
+        keptDirections(linearize, result.model_from_scan, result.hessian, degeneracy_threshold, config);
     if (!kept) return std::nullopt;
     result.degeneracy = *kept;
   }
@@ -135,6 +135,14 @@ bool hasConverged(const StepSize& step, const std::optional<StepSize>& previous,
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config, const ScanRefresh& refresh) {
+  const Linearize linearize = [&backend](const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+    return backend.linearize(model_from_scan, kernel_scale);
+  };
+  return registerScan(linearize, initial_guess, informed_guess, config, refresh);
+}
+
+RegistrationResult registerScan(const Linearize& linearize, const Eigen::Isometry3d& initial_guess,
+                                bool informed_guess, const RegistrationConfig& config, const ScanRefresh& refresh) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
   KernelSchedule kernel(config, informed_guess);
@@ -145,11 +153,11 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
   Vector6d g;
   std::optional<StepSize> previous;  // the last step, while the cost (kernel and scan) stayed the same
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    result.last = backend.linearize(result.model_from_scan, kernel.scale());
+    result.last = linearize(result.model_from_scan, kernel.scale());
     result.weight = fusionWeight(result.last, config);
     fuseNormalEquations(result.last, result.weight, result.hessian, g);
     result.iterations = iteration + 1;
-    const std::optional<Vector6d> step = gaussNewtonStep(backend, iteration, g, degeneracy_threshold, config, result);
+    const std::optional<Vector6d> step = gaussNewtonStep(linearize, iteration, g, degeneracy_threshold, config, result);
     if (!step) {
       result.failed = true;
       return result;

@@ -22,6 +22,7 @@
 
 #include "diagnostics.hpp"
 #include "elo/odometry.hpp"
+#include "localization_face.hpp"
 #include "messages.hpp"
 #include "parameters.hpp"
 #include "scan_queue.hpp"
@@ -39,6 +40,7 @@ class OdometryNodelet : public nodelet::Nodelet {
     nav_msgs::Odometry odometry;
     std::optional<nav_msgs::Path> path;
     std::optional<sensor_msgs::PointCloud2> model_nonground, model_ground, scan_ground, scan_nonground;
+    std::optional<LocalizationFace::Messages> localization;
   };
 
   void onInit() override;
@@ -77,6 +79,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::vector<double> trajectory_stamps_;
   std::vector<Eigen::Isometry3d> trajectory_poses_;  // the sensor's, as elo_run writes them
   std::deque<geometry_msgs::PoseStamped> path_;
+  // The localization mode (~localization_map): the scan the odometry processed, localized in a saved map.
+  std::unique_ptr<LocalizationFace> localization_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
