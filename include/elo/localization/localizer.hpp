@@ -58,6 +58,7 @@ struct LocalizationResult {
   int scans_since_match = 0;
   size_t map_points_rendered = 0;
   double milliseconds = 0.0;  // the localization's own time on this scan (render, registration, search)
+  double render_milliseconds = 0.0;  // of it, rendering the map
 };
 
 class Localizer {
@@ -97,8 +98,9 @@ class Localizer {
     MapMatchHealth health;
     Matrix6d hessian = Matrix6d::Zero();
   };
-  // Renders the map around `map_from_sensor` into the backend's map model; the number of points rendered.
-  size_t render(const Eigen::Isometry3d& map_from_sensor);
+  // Renders the map around `map_from_sensor` into the backend's map model, timed into `result`; the
+  // number of points rendered.
+  size_t render(const Eigen::Isometry3d& map_from_sensor, LocalizationResult& result);
   // Registers the scan against the rendered map from `rendered_from_scan`.
   Match registerAgainstMap(const Eigen::Isometry3d& rendered, const Eigen::Isometry3d& rendered_from_scan,
                            bool informed, int max_iterations);

@@ -113,10 +113,12 @@ double Localizer::sensorHeightAt(const Eigen::Vector2d& xy) const {
   return heights[heights.size() / 4] + config_.ground.sensor_height;
 }
 
-size_t Localizer::render(const Eigen::Isometry3d& map_from_sensor) {
+size_t Localizer::render(const Eigen::Isometry3d& map_from_sensor, LocalizationResult& result) {
+  const auto start = Clock::now();
   nearby_.clear();
   tiles_.pointsNear(map_from_sensor.translation(), config_.localization.render_range, nearby_);
   odometry_.backend().renderMap(nearby_, map_from_sensor);
+  result.render_milliseconds += millisecondsSince(start);
   return nearby_.size();
 }
 
@@ -141,7 +143,7 @@ std::optional<Localizer::Match> Localizer::search(const PoseHint& hint, Localiza
     if (!std::isfinite(z)) return std::nullopt;
     around.map_from_sensor.translation().z() = z;
   }
-  result.map_points_rendered = render(around.map_from_sensor);
+  result.map_points_rendered = render(around.map_from_sensor, result);
   if (result.map_points_rendered == 0) return std::nullopt;
   // Every candidate a few steps, then the best few to convergence.
   std::vector<Match> scored;
@@ -158,7 +160,7 @@ std::optional<Localizer::Match> Localizer::search(const PoseHint& hint, Localiza
     if (!best || fitsBetter(match.health, best->health)) best = match;
   }
   // The winner registered once more against the map rendered where it stands, as tracking will.
-  render(best->map_from_sensor);
+  render(best->map_from_sensor, result);
   return registerAgainstMap(best->map_from_sensor, Eigen::Isometry3d::Identity(), false,
                             config_.registration.max_iterations);
 }
@@ -193,7 +195,7 @@ void Localizer::refuse(const std::string& why, LocalizationResult& result) {
 
 void Localizer::track(LocalizationResult& result) {
   const Eigen::Isometry3d predicted = map_from_odom_ * odometry_.modelPose();
-  result.map_points_rendered = render(predicted);
+  result.map_points_rendered = render(predicted, result);
   if (result.map_points_rendered == 0) return;  // the map has nothing here: the odometry carries the pose
   result.attempted = true;
   const Match match =
