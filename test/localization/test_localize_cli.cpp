@@ -84,6 +84,11 @@ TEST_F(LocalizeCli, LocalizesFromTheMapOriginByDefault) {
   EXPECT_NE(result.output.find("normals estimated"), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("localization: "), std::string::npos) << result.output;
   EXPECT_LT(worstError(poses, 0), 0.1) << result.output;
+  // The summary's figures, for the record.
+  for (size_t start = 0, end; (end = result.output.find('\n', start)) != std::string::npos; start = end + 1) {
+    const std::string line = result.output.substr(start, end - start);
+    if (line.rfind("localization:", 0) == 0 || line.rfind("FPS", 0) == 0) std::printf("%s\n", line.c_str());
+  }
 }
 
 TEST_F(LocalizeCli, TakesAnInitialPoseWithTheHeightFromTheMap) {
