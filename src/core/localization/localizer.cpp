@@ -108,7 +108,7 @@ double Localizer::sensorHeightAt(const Eigen::Vector2d& xy) const {
     if (std::abs(map_->normals[point].z()) >= kMinGroundNormalZ) heights.push_back(map_->points[point].z());
   }
   if (heights.empty()) return NAN;
-  // The lower half's median: the road, not a roof or a table top that lies within the disc.
+  // The lower quartile: the road, not a roof or a car's top that lies within the disc.
   std::sort(heights.begin(), heights.end());
   return heights[heights.size() / 4] + config_.ground.sensor_height;
 }
