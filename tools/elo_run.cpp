@@ -26,6 +26,7 @@
 #include "elo/odometry.hpp"
 #include "command_line.hpp"
 #include "scan_sources.hpp"
+#include "localization_run.hpp"
 
 namespace {
 
@@ -65,6 +66,13 @@ options:
   --no-prefetch        upload each scan to the GPU only when it is processed, as the node does, not
                        while the scan before it is (the poses are the same)
   --quiet              no progress bar
+  --localize MAP.pcd   localize in a saved map (PCD: x y z [intensity] [normal_x normal_y normal_z], in
+                       the map frame; normals estimated at load when absent): POSES are then the
+                       sensor's poses in the map frame (docs/localization.md)
+  --initial-pose "x y z yaw_deg"
+                       with --localize: the sensor's pose in the map at the first scan, searched
+                       around (localization.search_*); default the map's origin, as a map made by
+                       elo_run --map of a drive that started where this one does
   --dump-config        print the effective configuration as YAML and exit
   --help
 )";
@@ -78,6 +86,8 @@ struct Options {
   std::string tum_output;
   std::string camera_output;
   std::string map_output;
+  std::string localize_map;
+  Eigen::Isometry3d initial_pose = Eigen::Isometry3d::Identity();
   std::vector<std::pair<std::string, std::string>> overrides;
   size_t max_frames = 0;
   size_t stride = 1;
@@ -138,6 +148,10 @@ Options parseArguments(int argc, char** argv) {
       options.prefetch = false;
     } else if (arguments.is("--quiet")) {
       options.quiet = true;
+    } else if (arguments.is("--localize")) {
+      options.localize_map = arguments.value();
+    } else if (arguments.is("--initial-pose")) {
+      options.initial_pose = elo::tools::parseInitialPose(arguments.value());
     } else if (arguments.is("--dump-config")) {
       options.dump_config = true;
     } else {
@@ -363,8 +377,11 @@ class MapOutput {
 // line repeats the last pose) or, with --strict, ends the run with an IoError.
 class ScanLoop {
  public:
-  ScanLoop(const Options& options, const elo::ScanSource& source, elo::Odometry& odometry, MapOutput* map)
-      : options_(options), source_(source), odometry_(odometry), map_(map), report_(options.prefetch) {
+  // With a `localizer`, each scan is localized after the odometry processed it, and its pose is the map's.
+  ScanLoop(const Options& options, const elo::ScanSource& source, elo::Odometry& odometry, MapOutput* map,
+           elo::Localizer* localizer)
+      : options_(options), source_(source), odometry_(odometry), map_(map), localizer_(localizer),
+        report_(options.prefetch) {
     if (options.timing_csv.empty()) return;
     timing_.open(options.timing_csv);
     if (!timing_) throw elo::IoError("cannot write " + options.timing_csv);
@@ -381,7 +398,8 @@ class ScanLoop {
       const ScanRead current = std::move(next);
       if (i + 1 < played.size()) next = readPlayed(played[i + 1]);
       const elo::FrameResult result = processScan(played[i].index, current);
-      trajectory.poses.push_back(result.pose);  // a skipped scan repeats the last pose, keeping lines aligned
+      // A skipped scan repeats the last pose, keeping lines aligned.
+      trajectory.poses.push_back(localizer_ ? localize(played[i].index, result) : result.pose);
       trajectory.stamps.push_back(played[i].stamp);
       if (timing_.is_open()) writeTimingRow(timing_, i, played[i].stamp, result);
       if (progress) showProgress(i + 1, played.size());
@@ -389,9 +407,21 @@ class ScanLoop {
   }
 
   const Report& report() const { return report_; }
+  const elo::tools::LocalizationReport& localizationReport() const { return localization_report_; }
   size_t nonFinitePoints() const { return non_finite_points_; }
 
  private:
+  Eigen::Isometry3d localize(size_t scan, const elo::FrameResult& result) {
+    const elo::LocalizationState before = localizer_->state();
+    const elo::LocalizationResult localized = localizer_->update(result);
+    localization_report_.add(localized, result.times.total);
+    if (localized.state != before || (localized.searched && !localized.matched)) {
+      std::fprintf(stderr, "\nscan %zu: localization %s%s%s\n", scan, elo::stateName(localized.state),
+                   localized.refusal.empty() ? "" : ": ", localized.refusal.c_str());
+    }
+    return localized.pose;
+  }
+
   // Reads the scan, stamped as played, and prefetches it unless --no-prefetch.
   ScanRead readPlayed(const elo::PlayedScan& played) {
     const auto start = std::chrono::steady_clock::now();
@@ -418,7 +448,7 @@ class ScanLoop {
       std::fprintf(stderr, "\nscan %zu: gap longer than model.time_window, model restarted at the last pose\n", scan);
     }
     report_.add(result, odometry_.backend().lastUploadMilliseconds());
-    if (map_ != nullptr) map_->add(odometry_, result, *read.cloud);
+    if (map_ != nullptr) map_->add(odometry_, result, read.scan->cloud);
     return result;
   }
 
@@ -443,8 +473,10 @@ class ScanLoop {
   const elo::ScanSource& source_;
   elo::Odometry& odometry_;
   MapOutput* map_;
+  elo::Localizer* localizer_;
   std::ofstream timing_;
   Report report_;
+  elo::tools::LocalizationReport localization_report_;
   size_t non_finite_points_ = 0;
   std::set<std::string> warned_;
 };
@@ -475,7 +507,12 @@ int run(const Options& options) {
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
   std::optional<MapOutput> map;
   if (!options.map_output.empty()) map.emplace(options.map_output, config.map);
-  ScanLoop loop(options, *source, odometry, map ? &*map : nullptr);
+  std::unique_ptr<elo::Localizer> localizer;
+  if (!options.localize_map.empty()) {
+    localizer = std::make_unique<elo::Localizer>(odometry, elo::tools::loadMap(options.localize_map, config));
+    localizer->setInitialPose(options.initial_pose);
+  }
+  ScanLoop loop(options, *source, odometry, map ? &*map : nullptr, localizer.get());
   Trajectory trajectory;
   const auto start = std::chrono::steady_clock::now();
   try {
@@ -497,6 +534,7 @@ int run(const Options& options) {
     std::printf("map cost a scan (CPU time): %.2f ms copying its points (odometry's thread), %.2f ms adding them "
                 "(map's thread); the pipeline took %.1f ms (wall)\n", copy_ms, add_ms, pipeline_ms);
   }
+  if (localizer) loop.localizationReport().print(*localizer);
   return 0;
 }
 

@@ -6,12 +6,15 @@
 #include <Eigen/Geometry>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "elo/config.hpp"
 #include "elo/se3.hpp"
 #include "elo/types.hpp"
 
 namespace elo {
+
+struct PointMap;
 
 // The reductions of one Gauss-Newton step, per cost term, before fusion (Eq. 1-2). Sums over the
 // correspondences that passed the gates; `candidates` counts the points that were tried.
@@ -94,6 +97,22 @@ class Backend {
   // for its own upload (all of it unless prefetched), and in finishPrefetch(), for the next scan's
   // arrays to be read; 0 on the host.
   virtual double lastUploadMilliseconds() const { return 0.0; }
+
+  // Localization on a saved map (localization/localizer.hpp): a second model, rendered from map points
+  // instead of fused from scans, that the current scan's features register against with the same cost.
+  // A backend that cannot (rendersMaps() false) throws std::runtime_error saying so from the others.
+  virtual bool rendersMaps() const { return false; }
+  // Hands over the map (kept until the next call); `map` must have normals (prepareMap()).
+  virtual void setMap(std::shared_ptr<const PointMap> map);
+  // Renders map points `points` (indices into the map) seen from the sensor at `map_from_sensor` into
+  // the map model: the non-ground range image (points with a normal, each covering a disc of
+  // localization.splat_radius) and the ground BEV (points whose height lies in the ground segmentation's
+  // band), in the sensor's frame, as the model of a scan taken there would hold them.
+  virtual void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor);
+  // linearize() against the rendered map model: `rendered_from_scan` moves the scan's features into the
+  // frame the map was rendered in.
+  virtual NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale);
+  virtual const Model& mapModel();
 };
 
 // Makes the backend `config.runtime.backend` names. When that is the CUDA backend and it cannot run here

@@ -181,6 +181,30 @@ struct RuntimeConfig {
   int threads = 0;  // 0: all hardware threads
 };
 
+// Localization on a saved map (docs/localization.md): the map rendered around the predicted pose into
+// a second model, the scan registered against it, map -> odom corrected from accepted matches.
+struct LocalizationConfig {
+  double render_range = 80.0;    // m around the sensor whose map points are rendered each match
+  double tile_size = 20.0;       // m: the map index's square tiles
+  // Each map point covers a disc of this radius (m) in the range image, so that a map sampled sparser
+  // than the image's pixels near the sensor leaves no holes for farther surfaces to show through.
+  double splat_radius = 0.1;
+  double normal_radius = 0.5;    // m: neighbours of a map point fitted for its normal when the file has none
+  // A match is accepted when at least this share of the scan's features find a map correspondence
+  // and their point-to-plane RMS is at most max_rms (m).
+  double min_inlier_share = 0.5;
+  double max_rms = 0.12;
+  double max_correction = 1.0;   // m: a tracked match moving the pose further than this is refused
+  int lost_after = 10;           // refused or failed matches in a row that declare the vehicle lost
+  // The initial-pose search around a hint: positions within search_radius (m) every search_step (m),
+  // yaws within search_yaw_deg either side every search_yaw_step_deg.
+  double search_radius = 2.5;
+  double search_step = 1.0;
+  double search_yaw_deg = 15.0;
+  double search_yaw_step_deg = 5.0;
+  int search_refined = 6;        // best-scored candidates registered to convergence
+};
+
 struct Config {
   SensorConfig sensor;
   GroundConfig ground;
@@ -191,6 +215,7 @@ struct Config {
   DeskewConfig deskew;
   MapConfig map;
   RuntimeConfig runtime;
+  LocalizationConfig localization;
 };
 
 // A parameter that YAML files, ROS parameters and command lines all set by the same dotted key

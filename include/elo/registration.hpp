@@ -68,4 +68,11 @@ using ScanRefresh = std::function<bool(const Eigen::Isometry3d& model_from_scan,
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config, const ScanRefresh& refresh = {});
 
+// The sums of one Gauss-Newton step (Backend::linearize() or Backend::linearizeMap()).
+using Linearize = std::function<NormalEquations(const Eigen::Isometry3d& model_from_scan, double kernel_scale)>;
+// The same loop over any model the scan is linearised against: localization registers the scan against
+// the map model (Backend::linearizeMap()) with it.
+RegistrationResult registerScan(const Linearize& linearize, const Eigen::Isometry3d& initial_guess,
+                                bool informed_guess, const RegistrationConfig& config, const ScanRefresh& refresh = {});
+
 }  // namespace elo

@@ -196,6 +196,29 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("runtime.backend_fallback", c.runtime.backend_fallback,
                 "with backend cuda and no usable GPU, run on the CPU backend with a warning instead of failing"),
       bindField("runtime.threads", c.runtime.threads, "CPU threads, 0 = all"),
+      bindField("localization.render_range", c.localization.render_range,
+                "m around the sensor whose map points are rendered for each map match"),
+      bindField("localization.tile_size", c.localization.tile_size, "m: side of the map index's tiles"),
+      bindField("localization.splat_radius", c.localization.splat_radius,
+                "m: radius of the disc each map point covers in the rendered range image"),
+      bindField("localization.normal_radius", c.localization.normal_radius,
+                "m: neighbourhood fitted for a map point's normal when the map file has none"),
+      bindField("localization.min_inlier_share", c.localization.min_inlier_share,
+                "share of the scan's features that must find a map correspondence for a match to be accepted"),
+      bindField("localization.max_rms", c.localization.max_rms,
+                "m: point-to-plane RMS of the correspondences above which a match is refused"),
+      bindField("localization.max_correction", c.localization.max_correction,
+                "m: a tracked match moving the pose further than this from the prediction is refused"),
+      bindField("localization.lost_after", c.localization.lost_after,
+                "refused or failed map matches in a row after which the vehicle is lost"),
+      bindField("localization.search_radius", c.localization.search_radius,
+                "m: the initial-pose search tries positions within this distance of the hint"),
+      bindField("localization.search_step", c.localization.search_step, "m between the search's positions"),
+      bindField("localization.search_yaw_deg", c.localization.search_yaw_deg,
+                "deg: the search tries yaws within this angle either side of the hint's"),
+      bindField("localization.search_yaw_step_deg", c.localization.search_yaw_step_deg, "deg between the search's yaws"),
+      bindField("localization.search_refined", c.localization.search_refined,
+                "best-scored search candidates registered to convergence"),
   };
 }
 
@@ -203,6 +226,26 @@ void validate(const MapConfig& map) {
   require(map.voxel_size >= 0.01 && map.voxel_size <= 10.0, "map.voxel_size", "must lie in [0.01, 10] m");
   require(map.min_observations >= 1 && map.min_observations <= 1000, "map.min_observations", "must lie in [1, 1000]");
 }
+
+namespace {
+
+void validateLocalization(const LocalizationConfig& l) {
+  require(l.render_range > 0.0, "localization.render_range", "must be positive");
+  require(l.tile_size > 0.0, "localization.tile_size", "must be positive");
+  require(l.splat_radius >= 0.0, "localization.splat_radius", "must not be negative");
+  require(l.normal_radius > 0.0, "localization.normal_radius", "must be positive");
+  require(l.min_inlier_share >= 0.0 && l.min_inlier_share <= 1.0, "localization.min_inlier_share", "must lie in [0, 1]");
+  require(l.max_rms > 0.0, "localization.max_rms", "must be positive");
+  require(l.max_correction > 0.0, "localization.max_correction", "must be positive");
+  require(l.lost_after >= 1, "localization.lost_after", "must be at least 1");
+  require(l.search_radius >= 0.0, "localization.search_radius", "must not be negative");
+  require(l.search_step > 0.0, "localization.search_step", "must be positive");
+  require(l.search_yaw_deg >= 0.0 && l.search_yaw_deg <= 180.0, "localization.search_yaw_deg", "must lie in [0, 180]");
+  require(l.search_yaw_step_deg > 0.0, "localization.search_yaw_step_deg", "must be positive");
+  require(l.search_refined >= 1, "localization.search_refined", "must be at least 1");
+}
+
+}  // namespace
 
 void validate(const Config& c) {
   const SensorConfig& s = c.sensor;
@@ -277,6 +320,7 @@ void validate(const Config& c) {
   require(c.deskew.rounds >= 0 && c.deskew.rounds <= 5, "deskew.rounds", "must lie in [0, 5]");
   validate(c.map);
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
+  validateLocalization(c.localization);
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

@@ -81,11 +81,11 @@ constexpr double kPriorWeighsBelowThresholds = 3.0;
 // 75 m behind). A direction on which the prior weighs is therefore confirmed on the geometry alone: the
 // unweighted sums of the same correspondences, within the correspondence gate. That costs one
 // linearisation more, on those scans only.
-std::optional<Degeneracy> priorDirections(Backend& backend, const Eigen::Isometry3d& guess, const Matrix6d& weighted,
-                                          double threshold, const RegistrationConfig& config) {
+std::optional<Degeneracy> priorDirections(const Linearize& linearize, const Eigen::Isometry3d& guess,
+                                          const Matrix6d& weighted, double threshold, const RegistrationConfig& config) {
   const std::optional<Degeneracy> flagged = analyseDegeneracy(weighted, threshold);
   if (!flagged || !(flagged->eigenvalues[0] < kPriorWeighsBelowThresholds * threshold)) return flagged;
-  const NormalEquations geometry = backend.linearize(guess, 0.0);
+  const NormalEquations geometry = linearize(guess, 0.0);
   Matrix6d hessian;
   Vector6d unused_gradient;
   fuseNormalEquations(geometry, fusionWeight(geometry, config), hessian, unused_gradient);
@@ -95,13 +95,13 @@ std::optional<Degeneracy> priorDirections(Backend& backend, const Eigen::Isometr
 // The Gauss-Newton step of one iteration, weighed against the motion prior `guess` along the weak
 // directions decided on the first; nullopt when there is no step to trust: fewer than six constraints,
 // no translation or rotation constraint at all, or a singular system.
-std::optional<Vector6d> gaussNewtonStep(Backend& backend, int iteration, const Vector6d& gradient,
+std::optional<Vector6d> gaussNewtonStep(const Linearize& linearize, int iteration, const Vector6d& gradient,
                                         const Eigen::Isometry3d& guess, double degeneracy_threshold,
                                         const RegistrationConfig& config, RegistrationResult& result) {
   if (result.last.nonground.inliers + result.last.ground.inliers < 6) return std::nullopt;
   if (iteration == 0) {
     const std::optional<Degeneracy> decided =
-        priorDirections(backend, result.model_from_scan, result.hessian, degeneracy_threshold, config);
+        priorDirections(linearize, result.model_from_scan, result.hessian, degeneracy_threshold, config);
     if (!decided) return std::nullopt;
     result.degeneracy = *decided;
   }
@@ -139,6 +139,14 @@ bool hasConverged(const StepSize& step, const std::optional<StepSize>& previous,
 
 RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initial_guess, bool informed_guess,
                                 const RegistrationConfig& config, const ScanRefresh& refresh) {
+  const Linearize linearize = [&backend](const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+    return backend.linearize(model_from_scan, kernel_scale);
+  };
+  return registerScan(linearize, initial_guess, informed_guess, config, refresh);
+}
+
+RegistrationResult registerScan(const Linearize& linearize, const Eigen::Isometry3d& initial_guess,
+                                bool informed_guess, const RegistrationConfig& config, const ScanRefresh& refresh) {
   RegistrationResult result;
   result.model_from_scan = initial_guess;
   KernelSchedule kernel(config, informed_guess);
@@ -149,12 +157,12 @@ RegistrationResult registerScan(Backend& backend, const Eigen::Isometry3d& initi
   Vector6d g;
   std::optional<StepSize> previous;  // the last step, while the cost (kernel and scan) stayed the same
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    result.last = backend.linearize(result.model_from_scan, kernel.scale());
+    result.last = linearize(result.model_from_scan, kernel.scale());
     result.weight = fusionWeight(result.last, config);
     fuseNormalEquations(result.last, result.weight, result.hessian, g);
     result.iterations = iteration + 1;
     const std::optional<Vector6d> step =
-        gaussNewtonStep(backend, iteration, g, initial_guess, degeneracy_threshold, config, result);
+        gaussNewtonStep(linearize, iteration, g, initial_guess, degeneracy_threshold, config, result);
     if (!step) {
       result.failed = true;
       return result;

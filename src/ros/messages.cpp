@@ -94,6 +94,15 @@ sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_
   return cloud.finish();
 }
 
+sensor_msgs::PointCloud2 localizationMapCloud(const elo::PointMap& map, size_t max_points,
+                                              const std_msgs::Header& header) {
+  VertexCloud cloud(header, false);
+  const size_t stride = max_points > 0 && map.size() > max_points ? (map.size() + max_points - 1) / max_points : 1;
+  cloud.reserve(map.size() / stride + 1);
+  for (size_t i = 0; i < map.size(); i += stride) cloud.add(map.points[i]);
+  return cloud.finish();
+}
+
 sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::PixelLabel label,
                                            const std_msgs::Header& header) {
   const bool with_normals = label == elo::PixelLabel::nonground;

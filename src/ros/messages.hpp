@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "elo/drive_map.hpp"
+#include "elo/localization/point_map.hpp"
 #include "elo/odometry.hpp"
 #include "elo/types.hpp"
 
@@ -23,6 +24,11 @@ sensor_msgs::PointCloud2 nonGroundModelCloud(const elo::SphericalImage& model, c
 // The ground model (BEV map): x y z, float32, one point per occupied cell. The BEV map stores no
 // normals: the registration fits them from neighbouring cells only where a scan point associates.
 sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_msgs::Header& header);
+
+// A saved map's points as x y z, float32: every point, or every n-th where the map has more than
+// `max_points` (0: no limit), for rviz.
+sensor_msgs::PointCloud2 localizationMapCloud(const elo::PointMap& map, size_t max_points,
+                                              const std_msgs::Header& header);
 
 // The scan's pixels carrying `label`; non-ground pixels with their normals (as nonGroundModelCloud),
 // ground pixels as x y z.

@@ -44,10 +44,21 @@ void OdometryNodelet::onInit() {
   }
   tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
   advertise();
+  try {
+    const LocalizationSettings localization = readLocalizationSettings(getPrivateNodeHandle());
+    if (!localization.map_file.empty()) {
+      localization_ = std::make_unique<LocalizationFace>(getNodeHandle(), getPrivateNodeHandle(), localization,
+                                                         *odometry_, odometry_mutex_);
+    }
+  } catch (const std::exception& error) {
+    NODELET_FATAL("cannot start localization: %s", error.what());
+    throw;
+  }
 
   diagnostics_ = std::make_unique<diagnostic_updater::Updater>(getNodeHandle(), getPrivateNodeHandle(), getName());
   diagnostics_->setHardwareID(odometry_->config().sensor.name);
   diagnostics_->add("odometry", &statistics_, &PipelineStatistics::report);
+  if (localization_) diagnostics_->add("localization", localization_.get(), &LocalizationFace::report);
   // A wall timer: diagnostics must keep coming while a replayed clock is paused or not yet started.
   diagnostics_timer_ = getNodeHandle().createWallTimer(ros::WallDuration(1.0),
                                                        [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
@@ -289,6 +300,7 @@ OdometryNodelet::ScanMessages OdometryNodelet::buildMessages(const elo::FrameRes
   if (scan_nonground_publisher_.getNumSubscribers() > 0) {
     messages.scan_nonground = labelledScanCloud(odometry_->backend().scan(), elo::PixelLabel::nonground, header);
   }
+  if (localization_) messages.localization = localization_->update(result, *frames_, header.stamp);
   return messages;
 }
 
@@ -300,6 +312,7 @@ void OdometryNodelet::publish(const ScanMessages& messages) {
   if (messages.model_ground) model_ground_publisher_.publish(*messages.model_ground);
   if (messages.scan_ground) scan_ground_publisher_.publish(*messages.scan_ground);
   if (messages.scan_nonground) scan_nonground_publisher_.publish(*messages.scan_nonground);
+  if (messages.localization) localization_->publish(*messages.localization);
 }
 
 void OdometryNodelet::forgetTrajectory() {
@@ -315,6 +328,7 @@ void OdometryNodelet::forgetTrajectory() {
 bool OdometryNodelet::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   std::lock_guard<std::mutex> lock(odometry_mutex_);
   odometry_->reset();
+  if (localization_) localization_->odometryReset();
   forgetTrajectory();
   response.success = true;
   response.message = "odometry reset: the next scan starts a new trajectory at the origin";

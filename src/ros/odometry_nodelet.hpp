@@ -23,6 +23,7 @@
 #include "diagnostics.hpp"
 #include "elo/map_builder.hpp"
 #include "elo/odometry.hpp"
+#include "localization_face.hpp"
 #include "messages.hpp"
 #include "parameters.hpp"
 #include "scan_queue.hpp"
@@ -40,6 +41,7 @@ class OdometryNodelet : public nodelet::Nodelet {
     nav_msgs::Odometry odometry;
     std::optional<nav_msgs::Path> path;
     std::optional<sensor_msgs::PointCloud2> model_nonground, model_ground, scan_ground, scan_nonground;
+    std::optional<LocalizationFace::Messages> localization;
   };
 
   void onInit() override;
@@ -90,6 +92,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::unique_ptr<elo::MapBuilder> map_;
   size_t map_generation_ = 0;  // counts the resets that cleared the map
   std::optional<double> last_map_stamp_;  // of the last `map` message; the map's thread's only
+  // The localization mode (~localization_map): the scan the odometry processed, localized in a saved map.
+  std::unique_ptr<LocalizationFace> localization_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -6,7 +6,7 @@
 #   launch_arguments_test.sh LAUNCH_DIR
 set -euo pipefail
 launch_dir=$1
-declare -A required=([elo.launch]="" [elo_node.launch]="" [elo_bag.launch]="bag trajectory_file")
+declare -A required=([elo.launch]="" [elo_node.launch]="" [elo_bag.launch]="bag trajectory_file" [elo_localization.launch]="map")
 status=0
 for file in "$launch_dir"/*.launch; do
   name=$(basename "$file")
@@ -27,5 +27,5 @@ done
 if grep '<arg ' "$launch_dir"/*.xml | grep -v 'doc='; then
   echo "FAIL: arguments without doc= above"; status=1
 fi
-[ "$status" = 0 ] && echo "every launch argument documented, rviz off; required: only elo_bag.launch's ${required[elo_bag.launch]}"
+[ "$status" = 0 ] && echo "every launch argument documented, rviz off; required: only elo_bag.launch's ${required[elo_bag.launch]} and elo_localization.launch's ${required[elo_localization.launch]}"
 exit "$status"

@@ -2,7 +2,10 @@
 
 #include "core/cpu/parallel.hpp"
 
+#include <stdexcept>
 #include <utility>
+
+#include "elo/localization/point_map.hpp"
 
 namespace elo::cpu {
 
@@ -28,6 +31,7 @@ CpuBackend::CpuBackend(const Config& config)
   scan_ground_.resize(bev_.rows, bev_.cols);
   allocate(model_, spherical_, bev_);
   allocate(fused_, spherical_, bev_);
+  allocate(map_model_, spherical_, bev_);
   winners_.resize(scan_.image.pixelCount());
   fusion_scratch_.resize(scan_.image.pixelCount());
 }
@@ -91,6 +95,15 @@ void CpuBackend::buildScanGroundMap() {
 }
 
 NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+  return linearizeAgainst(model_, ground_normals_, model_from_scan, kernel_scale);
+}
+
+NormalEquations CpuBackend::linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) {
+  return linearizeAgainst(map_model_, map_ground_normals_, rendered_from_scan, kernel_scale);
+}
+
+NormalEquations CpuBackend::linearizeAgainst(const Model& model, GroundNormalCache& ground_normals,
+                                             const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
   NormalEquations sums;
   const CostTerms terms = config_.registration.terms;
   // The two terms' sums are independent: they run side by side, so that the end of one loop, where
@@ -99,12 +112,12 @@ NormalEquations CpuBackend::linearize(const Eigen::Isometry3d& model_from_scan, 
     parallelInvoke(
         [&] {
           if (terms == CostTerms::bev_ground) return;
-          sums.nonground = nongroundSums(scan_, registration_pixels_, model_.nonground, spherical_, model_from_scan,
+          sums.nonground = nongroundSums(scan_, registration_pixels_, model.nonground, spherical_, model_from_scan,
                                          kernel_scale, config_.registration);
         },
         [&] {
           if (terms != CostTerms::fused && terms != CostTerms::bev_ground) return;
-          sums.ground = groundSums(scan_ground_, model_.ground, bev_, ground_normals_, model_from_scan, kernel_scale,
+          sums.ground = groundSums(scan_ground_, model.ground, bev_, ground_normals, model_from_scan, kernel_scale,
                                    config_.registration, config_.bev);
         });
   });
@@ -136,6 +149,29 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   });
   std::swap(model_, fused_);
   model_.initialized = true;
+}
+
+void CpuBackend::setMap(std::shared_ptr<const PointMap> map) {
+  if (map && !map->hasNormals() && map->size() > 0) throw std::invalid_argument("the map has no normals (prepareMap())");
+  map_ = std::move(map);
+  map_scratch_.closest.resize(scan_.image.pixelCount());
+  map_model_.nonground.clear();
+  map_model_.ground.clear();
+  map_model_.initialized = false;
+}
+
+void CpuBackend::renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) {
+  if (!map_) throw std::logic_error("renderMap() before setMap()");
+  const GroundConfig& ground = config_.ground;
+  const MapRendering rendering{static_cast<float>(config_.localization.splat_radius),
+                               static_cast<float>(-ground.sensor_height - ground.band_below),
+                               static_cast<float>(-ground.sensor_height + ground.band_above),
+                               static_cast<float>(config_.model.same_surface_distance)};
+  arena_.execute([&] {
+    renderMapModel(*map_, points, toRigid3f(map_from_sensor.inverse()), spherical_, bev_, rendering, map_scratch_,
+                   map_model_);
+    map_ground_normals_.reset(map_model_.ground.size());
+  });
 }
 
 void CpuBackend::resetModel() {

@@ -25,8 +25,17 @@ class CpuBackend final : public Backend {
   const BevImage& scanGround() override { return scan_ground_; }
   const Model& model() override { return model_; }
 
+  bool rendersMaps() const override { return true; }
+  void setMap(std::shared_ptr<const PointMap> map) override;
+  void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) override;
+  NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) override;
+  const Model& mapModel() override { return map_model_; }
+
  private:
   void buildScanGroundMap();
+  // The sums of the scan moved by `model_from_scan` against `model`, whose BEV normals `ground_normals` keeps.
+  NormalEquations linearizeAgainst(const Model& model, GroundNormalCache& ground_normals,
+                                   const Eigen::Isometry3d& model_from_scan, double kernel_scale);
 
   Config config_;
   SphericalProjection spherical_;
@@ -53,6 +62,12 @@ class CpuBackend final : public Backend {
   SphericalFusionScratch fusion_scratch_;
   NormalScratch normal_scratch_;
   GroundNormalCache ground_normals_;
+
+  // Localization (renderMap()): the map, the model last rendered from it and their scratch.
+  std::shared_ptr<const PointMap> map_;
+  Model map_model_;
+  MapRenderScratch map_scratch_;
+  GroundNormalCache map_ground_normals_;
 };
 
 }  // namespace elo::cpu

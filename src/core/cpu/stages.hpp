@@ -174,4 +174,27 @@ void fuseGroundModel(const BevImage& model, const BevImage& scan_ground, const B
 // Frame-to-frame: the model becomes the scan's non-ground features and ground map.
 void copyScanToModel(const ScanImage& scan, const BevImage& scan_ground, Model& model);
 
+// map_render.cpp: a saved map's points rendered into a model, as seen from a sensor pose (localization).
+// The scratch: each pixel's closest offer, and each listed point moved into the sensor's frame.
+struct MapRenderScratch {
+  ClosestWins closest;
+  std::vector<Float3> vertex;
+  std::vector<Float3> normal;
+  GroundMapScratch ground;
+};
+// How a map point is drawn: the disc it covers (m), and the band of heights below the sensor where a
+// point is ground (the ground segmentation's, GroundConfig) when its normal is near vertical or unknown.
+struct MapRendering {
+  float splat_radius;
+  float ground_low;   // -sensor_height - band_below
+  float ground_high;  // -sensor_height + band_above
+  float same_surface_distance;
+};
+// Renders `points` of `map` (which has normals) moved by `sensor_from_map` into `model`: the non-ground
+// points with a normal into its range image, closest wins per pixel, each covering the pixels its disc
+// spans (normals turned towards the sensor); the ground points into its BEV map.
+void renderMapModel(const PointMap& map, const std::vector<int32_t>& points, const Rigid3f& sensor_from_map,
+                    const SphericalProjection& spherical, const BevProjection& bev, const MapRendering& rendering,
+                    MapRenderScratch& scratch, Model& model);
+
 }  // namespace elo::cpu

@@ -1,0 +1,223 @@
+// Localization on a saved map (issue 28), on simulated drives with exact ground truth: a map made of one
+// drive of a world, other drives of the same world localized in it (another lane, a later start, other
+// noise and sensor unit, another sensor model), from an initial pose off by metres, and a kidnapped
+// vehicle. ELO_LOCALIZATION_LONG builds the long gates (over a kilometre) instead of the short ones.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "elo/localization/localizer.hpp"
+#include "elo/sim/sensors.hpp"
+#include "shared_world.hpp"
+
+namespace elo::test {
+namespace {
+
+#ifdef ELO_LOCALIZATION_LONG
+constexpr double kDriveSeconds = 130.0;  // about 1.2 km of the urban route
+constexpr int kMaxFrames = 100000;
+#else
+constexpr double kDriveSeconds = 12.0;   // the map's drive
+constexpr int kMaxFrames = 50;           // scans localized
+#endif
+constexpr double kMapVoxel = 0.2;          // m
+constexpr int kConvergedWithin = 20;       // scans
+
+Config sensorConfig(const std::string& sensor) {
+  Config config;
+  sim::loadSensor(sensor, config);
+  return config;
+}
+
+// The urban world of every gate, and the map of its first drive (HDL-64E, centre lane).
+class Localization : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = std::make_unique<SharedWorld>(sim::WorldFamily::urban, sim::TrajectoryKind::curves, kDriveSeconds + 6.0, 7);
+    const Drive mapping(*world_, sensorConfig("hdl64"), DrivePlan{0.0, 0.0, 11, 1});
+    const Config config = sensorConfig("hdl64");
+    map_ = std::make_shared<PointMap>(
+        mapOfDrive(mapping, mapping.frameCount(), 2, kMapVoxel, config.localization.normal_radius));
+  }
+  static void TearDownTestSuite() {
+    map_.reset();
+    world_.reset();
+  }
+
+  static std::unique_ptr<SharedWorld> world_;
+  static std::shared_ptr<PointMap> map_;
+};
+std::unique_ptr<SharedWorld> Localization::world_;
+std::shared_ptr<PointMap> Localization::map_;
+
+// A drive of another lane, starting later, with other noise and another unit of the sensor.
+DrivePlan otherDrive() { return DrivePlan{3.0, 1.2, 23, 2}; }
+
+Eigen::Isometry3d offsetBy(const Eigen::Isometry3d& pose, double metres, double yaw_deg) {
+  const Eigen::Vector3d shift(metres * std::cos(0.7), metres * std::sin(0.7), 0.0);
+  return pose * Eigen::Translation3d(shift) * Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ());
+}
+
+struct Localized {
+  std::vector<double> errors;  // position error per scan (m), NaN while not localized
+  std::vector<LocalizationResult> results;
+  std::vector<double> odometry_milliseconds;  // FrameResult::times.total
+  double rmse_after(int first) const {
+    double sum = 0.0;
+    int count = 0;
+    for (size_t i = static_cast<size_t>(first); i < errors.size(); ++i) {
+      sum += errors[i] * errors[i];
+      ++count;
+    }
+    return count > 0 ? std::sqrt(sum / count) : INFINITY;
+  }
+};
+
+// Localizes `frames` scans of `drive` from `hint` (for scan 0), `sensor`'s own config.
+Localized localize(const Drive& drive, const std::string& sensor, std::shared_ptr<PointMap> map,
+                   const Eigen::Isometry3d& hint, int frames) {
+  Config config = sensorConfig(sensor);
+  Odometry odometry(config);
+  Localizer localizer(odometry, map);
+  localizer.setInitialPose(hint);
+  Localized localized;
+  for (int frame = 0; frame < frames; ++frame) {
+    const FrameResult odometry_result = odometry.process(drive.scan(frame));
+    const LocalizationResult result = localizer.update(odometry_result);
+    const bool localized_now = result.state != LocalizationState::waiting_for_pose;
+    localized.errors.push_back(localized_now ? (result.pose.translation() - drive.pose(frame).translation()).norm() : NAN);
+    localized.results.push_back(result);
+    localized.odometry_milliseconds.push_back(odometry_result.times.total);
+  }
+  return localized;
+}
+
+int framesOf(const Drive& drive) { return std::min(drive.frameCount(), kMaxFrames); }
+
+// Mean and largest time of the localization on the scans that ran no search (ms), and of the searches.
+void printTimes(const Localized& run, const char* name) {
+  double tracking = 0.0;
+  double odometry = 0.0;
+  double rendering = 0.0;
+  size_t rendered = 0;
+  double worst = 0.0;
+  double searching = 0.0;
+  int tracked = 0;
+  int searches = 0;
+  for (size_t i = 0; i < run.results.size(); ++i) {
+    const LocalizationResult& result = run.results[i];
+    if (result.searched) {
+      searching += result.milliseconds;
+      ++searches;
+    } else {
+      tracking += result.milliseconds;
+      odometry += run.odometry_milliseconds[i];
+      rendering += result.render_milliseconds;
+      rendered += result.map_points_rendered;
+      worst = std::max(worst, result.milliseconds);
+      ++tracked;
+    }
+  }
+  tracked = std::max(tracked, 1);
+  std::printf("%s: localization %.1f ms a scan (largest %.1f; rendering %zu map points %.1f) on top of the odometry's "
+              "%.1f ms, %.0f ms a search\n",
+              name, tracking / tracked, worst, rendered / tracked, rendering / tracked, odometry / tracked,
+              searches > 0 ? searching / searches : 0.0);
+}
+
+TEST_F(Localization, Hdl64ConvergesFromTwoMetresAndTenDegreesOffAndTracks) {
+  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
+  const Localized run = localize(drive, "hdl64", map_, offsetBy(drive.pose(0), 2.0, 10.0), framesOf(drive));
+  ASSERT_TRUE(run.results.front().searched);
+  int converged = -1;
+  for (size_t i = 0; i < run.errors.size() && converged < 0; ++i) {
+    if (run.results[i].matched && run.errors[i] < 0.1) converged = static_cast<int>(i);
+  }
+  ASSERT_GE(converged, 0) << "never converged";
+  EXPECT_LT(converged, kConvergedWithin);
+  size_t matched = 0;
+  for (const auto& result : run.results) matched += result.matched ? 1 : 0;
+  const double rmse = run.rmse_after(kConvergedWithin);
+  std::printf("HDL-64E in the HDL-64E map: converged at scan %d, position RMSE %.3f m over %zu scans, %zu matched\n",
+              converged, rmse, run.errors.size(), matched);
+  printTimes(run, "HDL-64E");
+  EXPECT_LE(rmse, 0.10);
+  EXPECT_GT(matched, run.results.size() * 9 / 10);
+}
+
+// Another sensor model in the HDL-64E's map, its scans distorted by the motion (per-point times).
+TEST_F(Localization, Vlp16LocalizesInTheHdl64Map) {
+  sim::LidarOptions distorted;
+  distorted.deskewed = false;
+  const Drive drive(*world_, sensorConfig("vlp16"), otherDrive(), distorted);
+  const Localized run = localize(drive, "vlp16", map_, offsetBy(drive.pose(0), 1.0, 5.0), framesOf(drive));
+  const double rmse = run.rmse_after(kConvergedWithin);
+  size_t matched = 0;
+  for (const auto& result : run.results) matched += result.matched ? 1 : 0;
+  std::printf("VLP-16 in the HDL-64E map: position RMSE %.3f m over %zu scans, %zu matched\n", rmse,
+              run.errors.size(), matched);
+  printTimes(run, "VLP-16");
+  EXPECT_LE(rmse, 0.20);
+  EXPECT_GT(matched, run.results.size() * 3 / 4);
+}
+
+// A hint far outside the search is refused scan after scan: the pose never jumps to a bad match.
+TEST_F(Localization, AWrongHintIsNeverAccepted) {
+  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
+  Odometry odometry(sensorConfig("hdl64"));
+  Localizer localizer(odometry, map_);
+  for (int frame = 0; frame < 3; ++frame) {
+    localizer.setInitialPose(offsetBy(drive.pose(frame), 25.0, 0.0));
+    const LocalizationResult result = localizer.update(odometry.process(drive.scan(frame)));
+    EXPECT_TRUE(result.searched);
+    EXPECT_FALSE(result.matched) << "scan " << frame << ": inlier share " << result.health.inlier_share << ", RMS "
+                                 << result.health.rms;
+    EXPECT_EQ(result.state, LocalizationState::waiting_for_pose);
+  }
+}
+
+// The vehicle is carried 50 m along the road between two scans. The localizer refuses the matches at the
+// old place, declares itself lost, and relocalizes from a hint 4 m and 25 degrees off the truth.
+TEST_F(Localization, AKidnappedVehicleIsDetectedAndRelocalizedFromAHint) {
+  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
+  Odometry odometry(sensorConfig("hdl64"));
+  Localizer localizer(odometry, map_);
+  localizer.setInitialPose(drive.pose(0));
+  constexpr int kBefore = 15;
+  for (int frame = 0; frame < kBefore; ++frame) localizer.update(odometry.process(drive.scan(frame)));
+  ASSERT_EQ(localizer.state(), LocalizationState::tracking);
+  int landing = kBefore;
+  while (landing < drive.frameCount() &&
+         (drive.pose(landing).translation() - drive.pose(kBefore - 1).translation()).norm() < 50.0) {
+    ++landing;
+  }
+  ASSERT_LT(landing + 20, drive.frameCount()) << "the drive is too short to land 50 m on";
+  const int lost_after = odometry.config().localization.lost_after;
+  int frame = landing;
+  int detected = -1;
+  for (; frame < landing + lost_after + 5 && detected < 0; ++frame) {
+    const LocalizationResult result = localizer.update(odometry.process(drive.scan(frame)));
+    const double error = (result.pose.translation() - drive.pose(frame).translation()).norm();
+    if (result.matched) {
+      EXPECT_LT(error, 0.5) << "scan " << frame << ": a match accepted far from the truth";
+    }
+    if (result.state == LocalizationState::lost) detected = frame - landing;
+  }
+  ASSERT_GE(detected, 0) << "the kidnapping went unnoticed";
+  localizer.setInitialPose(offsetBy(drive.pose(frame), 4.0, 25.0), 5.0, 30.0);
+  const LocalizationResult relocalized = localizer.update(odometry.process(drive.scan(frame)));
+  EXPECT_TRUE(relocalized.searched);
+  ASSERT_TRUE(relocalized.matched) << "inlier share " << relocalized.health.inlier_share << ", RMS "
+                                   << relocalized.health.rms;
+  double worst = 0.0;
+  for (int after = frame + 1; after < std::min(frame + 20, drive.frameCount()); ++after) {
+    const LocalizationResult result = localizer.update(odometry.process(drive.scan(after)));
+    worst = std::max(worst, (result.pose.translation() - drive.pose(after).translation()).norm());
+  }
+  std::printf("kidnapped 50 m: detected after %d scans, relocalized in %.0f ms; worst error over the next 19 scans %.3f m\n",
+              detected, relocalized.milliseconds, worst);
+  EXPECT_LT(worst, 0.2);
+}
+
+}  // namespace
+}  // namespace elo::test

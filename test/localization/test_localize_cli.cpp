@@ -1,0 +1,113 @@
+// elo_run --localize as a user runs it: a simulated drive written as a sequence, a map of its every
+// other scan in the frame of its first (the frame elo_run --map writes), and the drive localized in it
+// from the default initial pose and from a given one whose height comes from the map.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <string>
+
+#include "../io/temp_directory.hpp"
+#include "elo/io/kitti.hpp"
+#include "elo/io/pcd.hpp"
+#include "elo/sim/sequence_writer.hpp"
+#include "shared_world.hpp"
+
+namespace elo::test {
+namespace {
+
+constexpr int kFrames = 40;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;
+};
+
+CommandResult runCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  char buffer[4096];
+  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+class LocalizeCli : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    directory_ = std::make_unique<TempDirectory>();
+    sim::SimulationSpec spec;
+    spec.world = sim::WorldFamily::urban;
+    spec.trajectory = sim::TrajectoryKind::curves;
+    spec.frames = kFrames;
+    spec.seed = 5;
+    const sim::Simulation simulation(spec);
+    sim::writeSequence(simulation, directory_->file("sequence"));
+    const Eigen::Isometry3d first_inverse = simulation.sensorPose(0).inverse();
+    const PointMap map = mapOfScans(
+        [&](int frame) {
+          return std::make_pair(simulation.scan(frame).cloud, first_inverse * simulation.sensorPose(frame));
+        },
+        kFrames, 2, 0.2, spec.config.localization.normal_radius);
+    PointMap without_normals = map;
+    without_normals.normals.clear();
+    writePointMap(directory_->file("map.pcd"), without_normals);
+  }
+  static void TearDownTestSuite() { directory_.reset(); }
+
+  // Runs elo_run --localize with `extra` options; the poses it wrote.
+  static std::vector<Eigen::Isometry3d> localize(const std::string& extra, CommandResult& result) {
+    const std::string poses = directory_->file("poses.txt");
+    result = runCommand(std::string(ELO_RUN_TOOL) + " --quiet --input " + directory_->file("sequence") + " --output " +
+                        poses + " --localize " + directory_->file("map.pcd") + " --threads 2 " + extra);
+    return result.exit_code == 0 ? readKittiPoses(poses) : std::vector<Eigen::Isometry3d>{};
+  }
+  static double worstError(const std::vector<Eigen::Isometry3d>& poses, size_t from) {
+    const std::vector<Eigen::Isometry3d> truth = readKittiPoses(directory_->file("sequence/poses.txt"));
+    double worst = 0.0;
+    for (size_t i = from; i < poses.size(); ++i) {
+      worst = std::max(worst, (poses[i].translation() - truth[i].translation()).norm());
+    }
+    return worst;
+  }
+
+  static std::unique_ptr<TempDirectory> directory_;
+};
+std::unique_ptr<TempDirectory> LocalizeCli::directory_;
+
+TEST_F(LocalizeCli, LocalizesFromTheMapOriginByDefault) {
+  CommandResult result;
+  const std::vector<Eigen::Isometry3d> poses = localize("", result);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_EQ(poses.size(), static_cast<size_t>(kFrames));
+  EXPECT_NE(result.output.find("normals estimated"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("localization: "), std::string::npos) << result.output;
+  EXPECT_LT(worstError(poses, 0), 0.1) << result.output;
+  // The summary's figures, for the record.
+  for (size_t start = 0, end; (end = result.output.find('\n', start)) != std::string::npos; start = end + 1) {
+    const std::string line = result.output.substr(start, end - start);
+    if (line.rfind("localization:", 0) == 0 || line.rfind("FPS", 0) == 0) std::printf("%s\n", line.c_str());
+  }
+}
+
+TEST_F(LocalizeCli, TakesAnInitialPoseWithTheHeightFromTheMap) {
+  CommandResult result;
+  const std::vector<Eigen::Isometry3d> poses = localize("--initial-pose '1.2 -0.8 nan 6'", result);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_LT(worstError(poses, 0), 0.1) << result.output;
+}
+
+TEST_F(LocalizeCli, RejectsAMalformedInitialPoseAndAMissingMap) {
+  CommandResult result;
+  localize("--initial-pose '1 2 3'", result);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--initial-pose expects"), std::string::npos) << result.output;
+  result = runCommand(std::string(ELO_RUN_TOOL) + " --input " + directory_->file("sequence") + " --output " +
+                      directory_->file("p.txt") + " --localize " + directory_->file("no_such_map.pcd"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("no_such_map.pcd"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace elo::test

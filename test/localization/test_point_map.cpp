@@ -1,0 +1,202 @@
+// The saved map of localization: loading and cleaning it, its normals, its tile index, and rendering it
+// into a backend's map model, on analytic maps with exact answers.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <random>
+
+#include "elo/backend.hpp"
+#include "elo/io/io_error.hpp"
+#include "elo/io/pcd.hpp"
+#include "elo/localization/point_map.hpp"
+
+namespace elo {
+namespace {
+
+// A square of the plane z = height, `size` metres wide, one point every `step` metres.
+void addFloor(PointMap& map, double size, double step, double height) {
+  for (double x = -size / 2; x < size / 2; x += step) {
+    for (double y = -size / 2; y < size / 2; y += step) map.points.emplace_back(x, y, height);
+  }
+}
+
+// A wall x = distance, from y -width/2 to width/2 and z 0 to height.
+void addWall(PointMap& map, double distance, double width, double height, double step) {
+  for (double y = -width / 2; y < width / 2; y += step) {
+    for (double z = step / 2; z < height; z += step) map.points.emplace_back(distance, y, z);
+  }
+}
+
+TEST(PointMap, PreparationDropsNonFinitePointsAndFitsPlaneNormals) {
+  PointMap map;
+  addFloor(map, 4.0, 0.1, 0.5);
+  const size_t floor_points = map.size();
+  map.points.emplace_back(NAN, 0.0f, 0.0f);
+  map.points.emplace_back(0.0f, INFINITY, 0.0f);
+  const MapPreparation preparation = prepareMap(map, 0.5);
+  EXPECT_EQ(preparation.non_finite_dropped, 2u);
+  EXPECT_TRUE(preparation.estimated);
+  ASSERT_EQ(map.size(), floor_points);
+  ASSERT_TRUE(map.hasNormals());
+  EXPECT_EQ(preparation.normals_estimated, floor_points);
+  for (const Vec3f& normal : map.normals) EXPECT_NEAR(std::abs(normal.z()), 1.0f, 1e-5f);
+}
+
+TEST(PointMap, IsolatedPointsGetNoNormalAndBadNormalsAreDropped) {
+  PointMap lonely;
+  lonely.points = {{0, 0, 0}, {5, 0, 0}, {10, 0, 0}};
+  prepareMap(lonely, 0.5);
+  for (const Vec3f& normal : lonely.normals) EXPECT_TRUE(normal.isZero());
+
+  PointMap given;
+  given.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  given.normals = {{0, 0, 1}, {0, 0, 2}, {NAN, 0, 0}};
+  const MapPreparation preparation = prepareMap(given, 0.5);
+  EXPECT_FALSE(preparation.estimated);
+  EXPECT_EQ(preparation.bad_normals, 2u);
+  EXPECT_EQ(given.normals[0], Vec3f(0, 0, 1));
+  EXPECT_TRUE(given.normals[1].isZero());
+  EXPECT_TRUE(given.normals[2].isZero());
+}
+
+TEST(PointMap, TilesFindExactlyThePointsWithinTheRadius) {
+  PointMap map;
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> coordinate(-300.0f, 300.0f);
+  for (int i = 0; i < 20000; ++i) map.points.emplace_back(coordinate(random), coordinate(random), coordinate(random) / 50);
+  for (const double tile : {7.0, 20.0, 100.0}) {
+    const MapTiles tiles(map, tile);
+    for (const Eigen::Vector3d& center : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(-250, 130, 4), Eigen::Vector3d(290, 299, 0)}) {
+      std::vector<int32_t> found;
+      tiles.pointsNear(center, 60.0, found);
+      std::sort(found.begin(), found.end());
+      std::vector<int32_t> expected;
+      for (size_t i = 0; i < map.size(); ++i) {
+        if ((map.points[i].head<2>().cast<double>() - center.head<2>()).norm() <= 60.0) expected.push_back(static_cast<int32_t>(i));
+      }
+      EXPECT_EQ(found, expected) << "tile " << tile << " centre " << center.transpose();
+    }
+  }
+}
+
+class MapFile : public testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = std::filesystem::temp_directory_path() / ("elo_point_map_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+  std::string path(const std::string& name) const { return (directory_ / name).string(); }
+
+  std::filesystem::path directory_;
+};
+
+TEST_F(MapFile, RoundTripsWithAndWithoutNormals) {
+  PointMap map;
+  addWall(map, 3.0, 2.0, 2.0, 0.25);
+  map.intensity.assign(map.size(), 7.0f);
+  writePointMap(path("bare.pcd"), map);
+  const PointMap bare = readPointMap(path("bare.pcd"));
+  EXPECT_EQ(bare.points, map.points);
+  EXPECT_EQ(bare.intensity, map.intensity);
+  EXPECT_TRUE(bare.normals.empty());
+
+  prepareMap(map, 0.6);
+  writePointMap(path("normals.pcd"), map);
+  const PointMap with_normals = readPointMap(path("normals.pcd"));
+  EXPECT_EQ(with_normals.normals, map.normals);
+}
+
+TEST_F(MapFile, SomeNormalFieldsButNotAllIsAnError) {
+  std::ofstream file(path("partial.pcd"));
+  file << "VERSION .7\nFIELDS x y z normal_x\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+          "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3 1\n";
+  file.close();
+  EXPECT_THROW(readPointMap(path("partial.pcd")), IoError);
+  EXPECT_THROW(readPointMap(path("missing.pcd")), IoError);
+}
+
+// Pixels of the rendered range image that hold a point, all on the wall.
+size_t renderedWallPixels(const Config& config, const std::shared_ptr<PointMap>& map, size_t floor_points) {
+  std::unique_ptr<Backend> backend = makeBackend(config);
+  EXPECT_TRUE(backend->rendersMaps());
+  backend->setMap(map);
+  std::vector<int32_t> all(map->size());
+  std::iota(all.begin(), all.end(), 0);
+  backend->renderMap(all, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, config.ground.sensor_height)));
+  const Model& model = backend->mapModel();
+  size_t wall_pixels = 0;
+  for (size_t pixel = 0; pixel < model.nonground.pixelCount(); ++pixel) {
+    if (!model.nonground.occupied(pixel)) continue;
+    ++wall_pixels;
+    EXPECT_NEAR(model.nonground.vertex[pixel].x(), 10.0f, 1e-4f);
+    EXPECT_NEAR(model.nonground.normal[pixel].x(), -1.0f, 1e-3f);
+  }
+  // Every floor point (0.2 m apart: each in a cell of its own) is ground; the wall is not.
+  EXPECT_EQ(model.ground.size(), floor_points);
+  for (const Vec3f& vertex : model.ground.vertex) EXPECT_NEAR(vertex.z(), -config.ground.sensor_height, 1e-4f);
+  return wall_pixels;
+}
+
+// A floor 1.73 m below the sensor and a wall 10 m ahead, points 0.2 m apart, rendered from the sensor:
+// the wall into the range image with normals facing the sensor, the floor into the BEV map. The wall
+// spans 39 degrees either side (440 columns) and from the image's top edge down to -9.3 degrees (35
+// rows): its points alone, 0.2 m apart (6.5 columns and 3.3 rows at 10 m), would fill a twentieth of
+// those pixels; covering their discs, they fill most.
+TEST(MapRendering, WallGoesToTheRangeImageAndFloorToTheBevMap) {
+  Config config;
+  config.runtime.threads = 2;
+  auto map = std::make_shared<PointMap>();
+  addFloor(*map, 30.0, 0.2, 0.0);
+  const size_t floor_points = map->size();
+  addWall(*map, 10.0, 16.0, 4.0, 0.2);
+  prepareMap(*map, config.localization.normal_radius);
+  const size_t wall_pixels = 440 * 35;
+  const size_t splatted = renderedWallPixels(config, map, floor_points);
+  config.localization.splat_radius = 0.0;
+  const size_t points_alone = renderedWallPixels(config, map, floor_points);
+  std::printf("wall pixels filled: %zu of %zu splatted, %zu by the points alone\n", splatted, wall_pixels, points_alone);
+  EXPECT_GE(splatted, wall_pixels * 3 / 4);
+  EXPECT_LE(points_alone, wall_pixels / 10);
+}
+
+// A backend without map rendering refuses, saying which backend and what to use instead.
+class NoMapsBackend : public Backend {
+ public:
+  const char* name() const override { return "cuda"; }
+  size_t projectScan(const PointCloud&, float, const SweepMotion&) override { return 0; }
+  void deskewScan(const Vector6d&) override {}
+  void segmentGround() override {}
+  void estimateNormals() override {}
+  void buildGroundMap() override {}
+  NormalEquations linearize(const Eigen::Isometry3d&, double) override { return {}; }
+  void updateModel(const Eigen::Isometry3d&, float) override {}
+  void resetModel() override {}
+  const ScanImage& scan() override { return scan_; }
+  const BevImage& scanGround() override { return ground_; }
+  const Model& model() override { return model_; }
+
+ private:
+  ScanImage scan_;
+  BevImage ground_;
+  Model model_;
+};
+
+TEST(MapRendering, ABackendWithoutItRefusesClearly) {
+  NoMapsBackend backend;
+  EXPECT_FALSE(backend.rendersMaps());
+  try {
+    backend.renderMap({}, Eigen::Isometry3d::Identity());
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("cuda backend cannot localize"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace elo
