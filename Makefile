@@ -77,15 +77,18 @@ test-tsan: deps
 	cd $(TSAN_BUILD) && $(TSAN_ENV) ctest --output-on-failure -L '^core$$' -j$(JOBS)
 
 # The core's tests in a baseline x86-64 build (ELO_NATIVE=OFF: SSE2, so the scalar code instead of the
-# AVX lanes, and no FMA), then its poses on the shared real scans against the -march=native build's, byte
-# for byte (tools/same_poses.sh; docs/platforms.md). Only what those need is built.
+# AVX lanes, and no FMA), then its poses on the shared real scans against the -march=native build's
+# (tools/same_poses.sh). Only what those need is built. Without FMA, fusedMultiplyAdd() and Eigen round
+# twice where the native build rounds once, so the poses differ in the last bits, which ICP carries to
+# at most 0.9 mm over the 60 scans: the bound is about twice that (docs/platforms.md).
 BASELINE_BUILD ?= build-baseline
+BASELINE_POSE_BOUND ?= 0.002
 test-baseline: build
 	cmake -S . -B $(BASELINE_BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_NATIVE=OFF -DELO_CUDA=OFF \
 	  -DELO_SHARED_DATA=$(SHARED_DATA) -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
 	cmake --build $(BASELINE_BUILD) --target test_core test_fault_cases test_backend_agreement elo_run -j$(JOBS)
 	cd $(BASELINE_BUILD) && ctest --output-on-failure -L '^core$$' -j$(JOBS)
-	tools/same_poses.sh $(BUILD) $(BASELINE_BUILD) $(SHARED_DATA)/real/hdl64_drive_a
+	tools/same_poses.sh $(BUILD) $(BASELINE_BUILD) $(SHARED_DATA)/real/hdl64_drive_a $(BASELINE_POSE_BOUND)
 
 # The ROS-free core and its tests cross-built for 64-bit ARM (cmake/aarch64-linux-gnu.cmake: Debian's
 # cross compiler and arm64 multiarch packages, ELO_CORE_ONLY) and run under qemu-user. Emulated code runs

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# The poses of two builds' elo_run on the shared real scans, compared byte for byte (the pose files
-# print each double exactly), in frame-to-model, frame-to-frame and frame-to-model with azimuth times.
-# `make test-baseline` runs it on the baseline x86-64 build (ELO_NATIVE=OFF: no AVX, no FMA) against
-# the -march=native one: the scalar code the AVX lanes stand in for must give the same poses
-# (docs/platforms.md). Fails where a setting's poses differ, printing by how much; skips, saying so,
-# without the scans.
-# usage: tools/same_poses.sh BUILD_A BUILD_B SCANS
+# The poses of two builds' elo_run on the shared real scans, compared in frame-to-model, frame-to-frame
+# and frame-to-model with azimuth times (the pose files print each double exactly). `make test-baseline`
+# runs it on the baseline x86-64 build (ELO_NATIVE=OFF: no AVX, no FMA) against the -march=native one
+# (docs/platforms.md). Without BOUND the poses must be the same bit for bit; with it, no pose entry may
+# differ by more than BOUND (metres for translations). Prints by how much each setting's poses differ;
+# skips, saying so, without the scans.
+# usage: tools/same_poses.sh BUILD_A BUILD_B SCANS [BOUND]
 set -euo pipefail
-[ $# -eq 3 ] || { echo "usage: $0 BUILD_A BUILD_B SCANS" >&2; exit 2; }
+[ $# -eq 3 ] || [ $# -eq 4 ] || { echo "usage: $0 BUILD_A BUILD_B SCANS [BOUND]" >&2; exit 2; }
 scans=$3
+bound=${4:-0}
 if [ ! -d "$scans" ]; then
   echo "same_poses: SKIPPED: no real scans at $scans (the shared data, ../shared/data)"
   exit 0
@@ -24,17 +25,22 @@ run_b=$(elo_run_of "$2")
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
-largest_difference() {  # the largest difference of any pose entry, and how many poses differ
-  python3 - "$1" "$2" <<'PY'
+compare() {  # SETTING: prints how many poses differ and by how much; fails past the bound
+  python3 - "$out/a.txt" "$out/b.txt" "$bound" "$1" <<'PY'
 import sys
 a = [list(map(float, line.split())) for line in open(sys.argv[1])]
 b = [list(map(float, line.split())) for line in open(sys.argv[2])]
-if len(a) != len(b):
-    print(f"{len(a)} against {len(b)} poses")
+bound, setting = float(sys.argv[3]), sys.argv[4]
+if len(a) != len(b) or not a:
+    sys.exit(f"same_poses: {setting}: {len(a)} against {len(b)} poses")
+differing = sum(x != y for x, y in zip(a, b))
+largest = max(abs(u - v) for x, y in zip(a, b) for u, v in zip(x, y))
+if differing == 0:
+    print(f"same_poses: {setting}: the {len(a)} poses are the same bit for bit")
 else:
-    differing = sum(x != y for x, y in zip(a, b))
-    largest = max(abs(u - v) for x, y in zip(a, b) for u, v in zip(x, y))
-    print(f"{differing} of {len(a)} poses differ, by up to {largest:.3g} in an entry (m for translations)")
+    print(f"same_poses: {setting}: {differing} of {len(a)} poses differ, by up to {largest:.3g} "
+          f"in an entry (m for translations; bound {bound:g})")
+sys.exit(1 if largest > bound else 0)
 PY
 }
 
@@ -44,11 +50,6 @@ for setting in "--mode f2m" "--mode f2f" "--mode f2m --set deskew.time_source=az
   "$run_a" --input "$scans" --output "$out/a.txt" --quiet $setting >/dev/null
   # shellcheck disable=SC2086
   "$run_b" --input "$scans" --output "$out/b.txt" --quiet $setting >/dev/null
-  if cmp -s "$out/a.txt" "$out/b.txt"; then
-    echo "same_poses: $setting: the $(wc -l <"$out/a.txt") poses are the same bit for bit"
-  else
-    echo "same_poses: $setting: $(largest_difference "$out/a.txt" "$out/b.txt")" >&2
-    status=1
-  fi
+  compare "$setting" || status=1
 done
 exit $status
