@@ -22,7 +22,8 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
 
-.PHONY: deps build test test-long compat test-sanitize test-asan test-tsan fuzz bench demo accuracy soak rviz-screenshot gpu-check clean
+.PHONY: deps build test test-long compat test-sanitize test-asan test-tsan test-baseline test-aarch64 deps-aarch64 fuzz \
+  bench demo accuracy soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -74,6 +75,36 @@ test-tsan: deps
 	cmake -S . -B $(TSAN_BUILD) $(SANITIZER_CMAKE) -DELO_SANITIZE=thread
 	cmake --build $(TSAN_BUILD) --target test_core -j$(JOBS)
 	cd $(TSAN_BUILD) && $(TSAN_ENV) ctest --output-on-failure -L '^core$$' -j$(JOBS)
+
+# The core's tests in a baseline x86-64 build (ELO_NATIVE=OFF: SSE2, so the scalar code instead of the
+# AVX lanes, and no FMA), then its poses on the shared real scans against the -march=native build's
+# (tools/same_poses.sh). Only what those need is built. Without FMA, fusedMultiplyAdd() and Eigen round
+# twice where the native build rounds once, so the poses differ in the last bits, which ICP carries to
+# at most 0.9 mm over the 60 scans: the bound is about twice that (docs/platforms.md).
+BASELINE_BUILD ?= build-baseline
+BASELINE_POSE_BOUND ?= 0.002
+test-baseline: build
+	cmake -S . -B $(BASELINE_BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_NATIVE=OFF -DELO_CUDA=OFF \
+	  -DELO_SHARED_DATA=$(SHARED_DATA) -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
+	cmake --build $(BASELINE_BUILD) --target test_core test_fault_cases test_backend_agreement elo_run -j$(JOBS)
+	cd $(BASELINE_BUILD) && ctest --output-on-failure -L '^core$$' -j$(JOBS)
+	tools/same_poses.sh $(BUILD) $(BASELINE_BUILD) $(SHARED_DATA)/real/hdl64_drive_a $(BASELINE_POSE_BOUND)
+
+# The ROS-free core and its tests cross-built for 64-bit ARM (cmake/aarch64-linux-gnu.cmake: Debian's
+# cross compiler and arm64 multiarch packages, ELO_CORE_ONLY) and run under qemu-user. Emulated code runs
+# many times slower, so the one test with a bound in seconds is left out (AARCH64_CTEST_EXCLUDE).
+AARCH64_BUILD ?= build-aarch64
+AARCH64_CTEST_EXCLUDE ?= ProcessedInBoundedTime
+AARCH64_PACKAGES := cmake libeigen3-dev g++-aarch64-linux-gnu qemu-user libtbb-dev:arm64 libgtest-dev:arm64
+deps-aarch64:
+	@dpkg --print-foreign-architectures | grep -qx arm64 || $(SUDO) dpkg --add-architecture arm64
+	@$(MAKE) --no-print-directory deps DEB_PACKAGES="$(AARCH64_PACKAGES)"
+
+test-aarch64: deps-aarch64
+	cmake -S . -B $(AARCH64_BUILD) -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake -DELO_CORE_ONLY=ON \
+	  -DCMAKE_BUILD_TYPE=Release -DELO_CUDA=OFF -DELO_SHARED_DATA=$(SHARED_DATA)
+	cmake --build $(AARCH64_BUILD) -j$(JOBS)
+	cd $(AARCH64_BUILD) && ctest --output-on-failure -E '$(AARCH64_CTEST_EXCLUDE)' -j$(JOBS)
 
 # libFuzzer over each reader of untrusted input (test/fuzz), FUZZ_SECONDS per target; tools/fuzz.sh
 # says where the corpus grows and where a crasher lands.
