@@ -30,7 +30,7 @@ deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  echo "Installing:" $$missing; \
-	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $$missing; \
+	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get -o DPkg::Lock::Timeout=600 install -y -qq $$missing; \
 	fi
 
 # The CUDA backend is built when nvcc is found: on PATH, or where the CUDA toolkit installs it.
@@ -63,12 +63,15 @@ TSAN_ENV := TSAN_OPTIONS=suppressions=$(SANITIZER_FILES)/tsan.supp:history_size=
 
 test-sanitize: test-asan test-tsan
 
-# Every test, the ROS ones included, but those labelled long (test/CMakeLists.txt) and the short demo:
-# under ASan the long drives take longer than CI can give them, and their code runs in shorter drives.
+# Every test, the ROS ones included, but those labelled long (test/CMakeLists.txt), the short demo and
+# the accuracy gates on simulated drives (ASAN_SKIP): under ASan those drives take longer than CI can give
+# them, and their code runs under it in shorter tests (the core's scenes, the fault drives, the real scans,
+# the map and localization tools' tests, the rostests). The normal build runs them all (make test).
+ASAN_SKIP ?= (DeskewAccuracy|DriveMapOnASimulatedDrive|SensorDrive|SparseSensors|Localization)\.
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) $(SANITIZER_CMAKE) -DELO_SANITIZE=address,undefined
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
-	cd $(ASAN_BUILD) && $(ASAN_ENV) ctest --output-on-failure -LE 'long|demo' -j$(JOBS)
+	cd $(ASAN_BUILD) && $(ASAN_ENV) ctest --output-on-failure -LE 'long|demo' -E '$(ASAN_SKIP)' -j$(JOBS)
 
 # The core library's tests: the threaded CPU kernels (TBB) and everything that calls them.
 test-tsan: deps
@@ -128,7 +131,8 @@ gpu-check: build
 
 # The package built and tested on Debian 11 (bullseye, the nearest twin of Noetic's Ubuntu 20.04) in a
 # debootstrap chroot cached in .compat/ (tools/compat.sh; root or sudo). COMPAT_TARGETS=core builds
-# everything and runs the core tests only, as CI does.
+# everything and runs the core tests only, as CI does; COMPAT_TARGETS=deps only makes the chroot and
+# installs its packages (CI does that first, in the background).
 COMPAT_TARGETS ?= test
 compat:
 	tools/compat.sh $(COMPAT_TARGETS)
