@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "command_line.hpp"
-#include "elo/io/pcd.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/localization/localizer.hpp"
 
 namespace elo::tools {
@@ -33,15 +33,17 @@ inline Eigen::Isometry3d parseInitialPose(std::string text) {
 }
 
 // Reads and prepares the map at `path` (normals estimated when it has none), saying what that did.
-inline std::shared_ptr<const PointMap> loadMap(const std::string& path, const Config& config) {
-  PointMap map = readPointMap(path);
-  const MapPreparation preparation = prepareMap(map, config.localization.normal_radius);
+inline std::shared_ptr<const MapCloud> loadMap(const std::string& path, const Config& config) {
+  size_t non_finite_skipped = 0;
+  MapCloud map = readMapPcd(path, &non_finite_skipped);
+  MapPreparation preparation = prepareMap(map, config.localization.normal_radius);
+  preparation.non_finite_dropped += non_finite_skipped;  // the reader's skips: prepareMap() found none left
   std::fprintf(stderr, "map %s: %zu points", path.c_str(), map.size());
   if (preparation.non_finite_dropped > 0) std::fprintf(stderr, ", %zu non-finite dropped", preparation.non_finite_dropped);
   if (preparation.bad_normals > 0) std::fprintf(stderr, ", %zu normals not unit vectors (dropped)", preparation.bad_normals);
   if (preparation.estimated) std::fprintf(stderr, ", normals estimated (%zu fitted)", preparation.normals_estimated);
   std::fprintf(stderr, "\n");
-  return std::make_shared<const PointMap>(std::move(map));
+  return std::make_shared<const MapCloud>(std::move(map));
 }
 
 // Counts what the localizer did over the run.

@@ -14,7 +14,7 @@
 
 namespace elo {
 
-struct PointMap;
+struct MapCloud;
 
 // The reductions of one Gauss-Newton step, per cost term, before fusion (Eq. 1-2). Sums over the
 // correspondences that passed the gates; `candidates` counts the points that were tried.
@@ -103,7 +103,7 @@ class Backend {
   // A backend that cannot (rendersMaps() false) throws std::runtime_error saying so from the others.
   virtual bool rendersMaps() const { return false; }
   // Hands over the map (kept until the next call); `map` must have normals (prepareMap()).
-  virtual void setMap(std::shared_ptr<const PointMap> map);
+  virtual void setMap(std::shared_ptr<const MapCloud> map);
   // Renders map points `points` (indices into the map) seen from the sensor at `map_from_sensor` into
   // the map model: the non-ground range image (points with a normal, each covering a disc of
   // localization.splat_radius) and the ground BEV (points whose height lies in the ground segmentation's

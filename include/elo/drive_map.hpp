@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
+#include "elo/map_cloud.hpp"
 #include "elo/types.hpp"
 
 namespace elo {
@@ -35,15 +36,6 @@ struct MapScan {
 MapScan mapScanOf(const ScanImage& scan, const PointCloud& cloud, const Eigen::Isometry3d& pose, double stamp,
                   double voxel_size);
 
-// The map as points: x y z, intensity, and a unit normal, or zero where none is known.
-struct MapCloud {
-  std::vector<Vec3f> points;
-  std::vector<float> intensity;
-  std::vector<Vec3f> normals;
-
-  size_t size() const { return points.size(); }
-};
-
 class DriveMap {
  public:
   // Throws ConfigError for an unusable map config (validate()).
@@ -52,8 +44,9 @@ class DriveMap {
   void add(const MapScan& scan);
   void clear();
 
-  // The voxels that pass the moving-object filter (MapConfig::min_observations), one point each; with
-  // `stride` > 1 only every stride-th of them (a thinned map for display).
+  // The voxels that pass the moving-object filter (MapConfig::min_observations), one point each, each
+  // with its intensity and normal (zero where none is known); with `stride` > 1 only every stride-th of
+  // them (a thinned map for display).
   MapCloud points(size_t stride = 1) const;
 
   size_t voxelCount() const { return voxels_; }

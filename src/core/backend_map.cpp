@@ -15,7 +15,7 @@ namespace {
 
 }  // namespace
 
-void Backend::setMap(std::shared_ptr<const PointMap> /*map*/) { refuseMaps(*this); }
+void Backend::setMap(std::shared_ptr<const MapCloud> /*map*/) { refuseMaps(*this); }
 void Backend::renderMap(const std::vector<int32_t>& /*points*/, const Eigen::Isometry3d& /*map_from_sensor*/) {
   refuseMaps(*this);
 }

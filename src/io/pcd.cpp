@@ -4,7 +4,6 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
-#include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -108,6 +107,7 @@ using io_detail::findField;
 using io_detail::isFloatingPoint;
 using io_detail::readScalar;
 using io_detail::addField;
+using io_detail::writeScalar;
 
 // The fields of a PCD scan that a PointCloud holds, checked once so that the per-point loop only reads.
 struct FieldLayout {
@@ -165,82 +165,7 @@ void appendPoint(const uint8_t* point, const Vec3f& position, const FieldLayout&
   }
 }
 
-template <typename T>
-void writeScalar(uint8_t* point, const PCLPointField& field, T value) {
-  std::memcpy(point + field.offset, &value, sizeof(T));
-}
-
-// The normal fields of a map, all three or none.
-std::optional<std::array<PCLPointField, 3>> findNormals(const std::vector<PCLPointField>& fields, const std::string& path) {
-  const char* names[] = {"normal_x", "normal_y", "normal_z"};
-  std::array<PCLPointField, 3> normals;
-  int found = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const std::optional<PCLPointField> field = findField(fields, names[axis]);
-    if (!field) continue;
-    if (!isFloatingPoint(field->datatype)) {
-      throw IoError("'" + path + "': field '" + names[axis] + "' must be float32 or float64");
-    }
-    normals[axis] = *field;
-    ++found;
-  }
-  if (found == 0) return std::nullopt;
-  if (found < 3) throw IoError("'" + path + "' has some of normal_x, normal_y, normal_z but not all three");
-  return normals;
-}
-
 }  // namespace
-
-PointMap readPointMap(const std::string& path) {
-  const io_detail::PcdPoints pcd = io_detail::parsePcd(io_detail::readFileBytes(path), path);
-  const FieldLayout layout = findLayout(pcd.fields, path);
-  const std::optional<std::array<PCLPointField, 3>> normals = findNormals(pcd.fields, path);
-  PointMap map;
-  map.points.reserve(pcd.count);
-  for (size_t i = 0; i < pcd.count; ++i) {
-    const uint8_t* point = pcd.data.data() + i * pcd.point_step;
-    map.points.push_back(readPosition(point, layout));
-    if (layout.intensity) {
-      map.intensity.push_back(static_cast<float>(readScalar(point + layout.intensity->offset, layout.intensity->datatype)));
-    }
-    if (normals) {
-      Vec3f normal;
-      for (int axis = 0; axis < 3; ++axis) {
-        normal[axis] = static_cast<float>(readScalar(point + (*normals)[axis].offset, (*normals)[axis].datatype));
-      }
-      map.normals.push_back(normal);
-    }
-  }
-  return map;
-}
-
-void writePointMap(const std::string& path, const PointMap& map) {
-  pcl::PCLPointCloud2 pcd;
-  addField(pcd, "x", PCLPointField::FLOAT32, 4);
-  addField(pcd, "y", PCLPointField::FLOAT32, 4);
-  addField(pcd, "z", PCLPointField::FLOAT32, 4);
-  addField(pcd, "intensity", PCLPointField::FLOAT32, 4);
-  const bool has_normals = map.hasNormals();
-  if (has_normals) {
-    addField(pcd, "normal_x", PCLPointField::FLOAT32, 4);
-    addField(pcd, "normal_y", PCLPointField::FLOAT32, 4);
-    addField(pcd, "normal_z", PCLPointField::FLOAT32, 4);
-  }
-  pcd.width = static_cast<uint32_t>(map.size());
-  pcd.height = 1;
-  pcd.is_dense = true;
-  pcd.row_step = pcd.point_step * pcd.width;
-  pcd.data.resize(static_cast<size_t>(pcd.row_step));
-  for (size_t i = 0; i < map.size(); ++i) {
-    uint8_t* point = pcd.data.data() + i * pcd.point_step;
-    for (int axis = 0; axis < 3; ++axis) writeScalar(point, pcd.fields[axis], map.points[i][axis]);
-    writeScalar(point, pcd.fields[3], map.intensity.size() == map.size() ? map.intensity[i] : 0.0f);
-    if (has_normals) {
-      for (int axis = 0; axis < 3; ++axis) writeScalar(point, pcd.fields[4 + axis], map.normals[i][axis]);
-    }
-  }
-  io_detail::savePcd(path, pcd);
-}
 
 PointCloud readPcd(const std::string& path, size_t* non_finite_skipped) {
   const io_detail::PcdPoints pcd = io_detail::parsePcd(io_detail::readFileBytes(path), path);

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,5 +50,10 @@ void addField(pcl::PCLPointCloud2& cloud, const std::string& name, uint8_t datat
 std::string readFileBytes(const std::string& path);
 // Binary PCD; IoError when it cannot be written.
 void savePcd(const std::string& path, const pcl::PCLPointCloud2& cloud);
+// Stores `value` into the field of the point at `point` (not necessarily aligned).
+template <typename T>
+void writeScalar(uint8_t* point, const pcl::PCLPointField& field, T value) {
+  std::memcpy(point + field.offset, &value, sizeof(T));
+}
 
 }  // namespace elo::io_detail

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "elo/io/pcd.hpp"
+#include "elo/io/map_pcd.hpp"
 
 namespace elo_ros {
 namespace {
@@ -18,13 +18,14 @@ Eigen::Isometry3d poseFromXyzYaw(const std::vector<double>& values) {
          Eigen::AngleAxisd(values[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ());
 }
 
-std::shared_ptr<const elo::PointMap> loadMap(const std::string& path, const elo::Config& config) {
-  elo::PointMap map = elo::readPointMap(path);
-  const elo::MapPreparation preparation = elo::prepareMap(map, config.localization.normal_radius);
-  ROS_INFO("localization map %s: %zu points%s%s", path.c_str(), map.size(),
-           preparation.estimated ? ", normals estimated" : "",
-           preparation.non_finite_dropped > 0 ? ", non-finite points dropped" : "");
-  return std::make_shared<const elo::PointMap>(std::move(map));
+std::shared_ptr<const elo::MapCloud> loadMap(const std::string& path, const elo::Config& config) {
+  size_t non_finite_skipped = 0;
+  elo::MapCloud map = elo::readMapPcd(path, &non_finite_skipped);
+  elo::MapPreparation preparation = elo::prepareMap(map, config.localization.normal_radius);
+  preparation.non_finite_dropped += non_finite_skipped;  // the reader's skips: prepareMap() found none left
+  ROS_INFO("localization map %s: %zu points%s, %zu non-finite points dropped", path.c_str(), map.size(),
+           preparation.estimated ? ", normals estimated" : "", preparation.non_finite_dropped);
+  return std::make_shared<const elo::MapCloud>(std::move(map));
 }
 
 // ROS order (x y z, rotation about x y z) is the core's twist order.

@@ -94,7 +94,7 @@ sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_
   return cloud.finish();
 }
 
-sensor_msgs::PointCloud2 localizationMapCloud(const elo::PointMap& map, size_t max_points,
+sensor_msgs::PointCloud2 localizationMapCloud(const elo::MapCloud& map, size_t max_points,
                                               const std_msgs::Header& header) {
   VertexCloud cloud(header, false);
   const size_t stride = max_points > 0 && map.size() > max_points ? (map.size() + max_points - 1) / max_points : 1;
@@ -134,7 +134,8 @@ sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Head
   message.row_step = message.point_step * message.width;
   message.data.resize(message.row_step);
   for (size_t i = 0; i < map.size(); ++i) {
-    const float values[4] = {map.points[i].x(), map.points[i].y(), map.points[i].z(), map.intensity[i]};
+    const float values[4] = {map.points[i].x(), map.points[i].y(), map.points[i].z(),
+                             i < map.intensity.size() ? map.intensity[i] : 0.0f};
     std::memcpy(message.data.data() + i * message.point_step, values, sizeof(values));
   }
   return message;

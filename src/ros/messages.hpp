@@ -10,8 +10,7 @@
 #include <Eigen/Geometry>
 #include <optional>
 
-#include "elo/drive_map.hpp"
-#include "elo/localization/point_map.hpp"
+#include "elo/map_cloud.hpp"
 #include "elo/odometry.hpp"
 #include "elo/types.hpp"
 
@@ -27,7 +26,7 @@ sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_
 
 // A saved map's points as x y z, float32: every point, or every n-th where the map has more than
 // `max_points` (0: no limit), for rviz.
-sensor_msgs::PointCloud2 localizationMapCloud(const elo::PointMap& map, size_t max_points,
+sensor_msgs::PointCloud2 localizationMapCloud(const elo::MapCloud& map, size_t max_points,
                                               const std_msgs::Header& header);
 
 // The scan's pixels carrying `label`; non-ground pixels with their normals (as nonGroundModelCloud),
@@ -35,7 +34,7 @@ sensor_msgs::PointCloud2 localizationMapCloud(const elo::PointMap& map, size_t m
 sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::PixelLabel label,
                                            const std_msgs::Header& header);
 
-// The drive's map for display: x y z intensity, float32, one point per map point.
+// A map for display (the drive's): x y z intensity (0 where it has none), float32, one point per map point.
 sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Header& header);
 
 // The model as one point list for elo::writePcd, moved by `transform` (sensor -> odom frame).

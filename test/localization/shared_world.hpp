@@ -103,7 +103,7 @@ using PlacedScan = std::function<std::pair<PointCloud, Eigen::Isometry3d>(int fr
 
 // The map of scans placed at their true poses (every `every`-th of `frames`), one point per `voxel` (the
 // centroid of the points that fell in it), normals estimated as a loaded map without them gets.
-inline PointMap mapOfScans(const PlacedScan& scan_at, int frames, int every, double voxel, double normal_radius) {
+inline MapCloud mapOfScans(const PlacedScan& scan_at, int frames, int every, double voxel, double normal_radius) {
   struct Voxel {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
@@ -129,13 +129,13 @@ inline PointMap mapOfScans(const PlacedScan& scan_at, int frames, int every, dou
       ++cell.count;
     }
   }
-  PointMap map;
+  MapCloud map;
   for (const auto& [unused, cell] : voxels) map.points.push_back((cell.sum / cell.count).cast<float>());
   prepareMap(map, normal_radius);
   return map;
 }
 
-inline PointMap mapOfDrive(const Drive& drive, int frames, int every, double voxel, double normal_radius) {
+inline MapCloud mapOfDrive(const Drive& drive, int frames, int every, double voxel, double normal_radius) {
   return mapOfScans([&drive](int frame) { return std::make_pair(drive.scan(frame), drive.pose(frame)); }, frames,
                     every, voxel, normal_radius);
 }

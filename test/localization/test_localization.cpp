@@ -36,7 +36,7 @@ class Localization : public testing::Test {
     world_ = std::make_unique<SharedWorld>(sim::WorldFamily::urban, sim::TrajectoryKind::curves, kDriveSeconds + 6.0, 7);
     const Drive mapping(*world_, sensorConfig("hdl64"), DrivePlan{0.0, 0.0, 11, 1});
     const Config config = sensorConfig("hdl64");
-    map_ = std::make_shared<PointMap>(
+    map_ = std::make_shared<MapCloud>(
         mapOfDrive(mapping, mapping.frameCount(), 2, kMapVoxel, config.localization.normal_radius));
   }
   static void TearDownTestSuite() {
@@ -45,10 +45,10 @@ class Localization : public testing::Test {
   }
 
   static std::unique_ptr<SharedWorld> world_;
-  static std::shared_ptr<PointMap> map_;
+  static std::shared_ptr<MapCloud> map_;
 };
 std::unique_ptr<SharedWorld> Localization::world_;
-std::shared_ptr<PointMap> Localization::map_;
+std::shared_ptr<MapCloud> Localization::map_;
 
 // A drive of another lane, starting later, with other noise and another unit of the sensor.
 DrivePlan otherDrive() { return DrivePlan{3.0, 1.2, 23, 2}; }
@@ -74,7 +74,7 @@ struct Localized {
 };
 
 // Localizes `frames` scans of `drive` from `hint` (for scan 0), `sensor`'s own config.
-Localized localize(const Drive& drive, const std::string& sensor, std::shared_ptr<PointMap> map,
+Localized localize(const Drive& drive, const std::string& sensor, std::shared_ptr<MapCloud> map,
                    const Eigen::Isometry3d& hint, int frames) {
   Config config = sensorConfig(sensor);
   Odometry odometry(config);

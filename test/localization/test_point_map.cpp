@@ -12,28 +12,28 @@
 
 #include "elo/backend.hpp"
 #include "elo/io/io_error.hpp"
-#include "elo/io/pcd.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/localization/point_map.hpp"
 
 namespace elo {
 namespace {
 
 // A square of the plane z = height, `size` metres wide, one point every `step` metres.
-void addFloor(PointMap& map, double size, double step, double height) {
+void addFloor(MapCloud& map, double size, double step, double height) {
   for (double x = -size / 2; x < size / 2; x += step) {
     for (double y = -size / 2; y < size / 2; y += step) map.points.emplace_back(x, y, height);
   }
 }
 
 // A wall x = distance, from y -width/2 to width/2 and z 0 to height.
-void addWall(PointMap& map, double distance, double width, double height, double step) {
+void addWall(MapCloud& map, double distance, double width, double height, double step) {
   for (double y = -width / 2; y < width / 2; y += step) {
     for (double z = step / 2; z < height; z += step) map.points.emplace_back(distance, y, z);
   }
 }
 
-TEST(PointMap, PreparationDropsNonFinitePointsAndFitsPlaneNormals) {
-  PointMap map;
+TEST(MapCloud, PreparationDropsNonFinitePointsAndFitsPlaneNormals) {
+  MapCloud map;
   addFloor(map, 4.0, 0.1, 0.5);
   const size_t floor_points = map.size();
   map.points.emplace_back(NAN, 0.0f, 0.0f);
@@ -47,13 +47,13 @@ TEST(PointMap, PreparationDropsNonFinitePointsAndFitsPlaneNormals) {
   for (const Vec3f& normal : map.normals) EXPECT_NEAR(std::abs(normal.z()), 1.0f, 1e-5f);
 }
 
-TEST(PointMap, IsolatedPointsGetNoNormalAndBadNormalsAreDropped) {
-  PointMap lonely;
+TEST(MapCloud, IsolatedPointsGetNoNormalAndBadNormalsAreDropped) {
+  MapCloud lonely;
   lonely.points = {{0, 0, 0}, {5, 0, 0}, {10, 0, 0}};
   prepareMap(lonely, 0.5);
   for (const Vec3f& normal : lonely.normals) EXPECT_TRUE(normal.isZero());
 
-  PointMap given;
+  MapCloud given;
   given.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
   given.normals = {{0, 0, 1}, {0, 0, 2}, {NAN, 0, 0}};
   const MapPreparation preparation = prepareMap(given, 0.5);
@@ -64,8 +64,8 @@ TEST(PointMap, IsolatedPointsGetNoNormalAndBadNormalsAreDropped) {
   EXPECT_TRUE(given.normals[2].isZero());
 }
 
-TEST(PointMap, TilesFindExactlyThePointsWithinTheRadius) {
-  PointMap map;
+TEST(MapCloud, TilesFindExactlyThePointsWithinTheRadius) {
+  MapCloud map;
   std::mt19937 random(3);
   std::uniform_real_distribution<float> coordinate(-300.0f, 300.0f);
   for (int i = 0; i < 20000; ++i) map.points.emplace_back(coordinate(random), coordinate(random), coordinate(random) / 50);
@@ -97,18 +97,18 @@ class MapFile : public testing::Test {
 };
 
 TEST_F(MapFile, RoundTripsWithAndWithoutNormals) {
-  PointMap map;
+  MapCloud map;
   addWall(map, 3.0, 2.0, 2.0, 0.25);
   map.intensity.assign(map.size(), 7.0f);
-  writePointMap(path("bare.pcd"), map);
-  const PointMap bare = readPointMap(path("bare.pcd"));
+  writeMapPcd(path("bare.pcd"), map);
+  const MapCloud bare = readMapPcd(path("bare.pcd"));
   EXPECT_EQ(bare.points, map.points);
   EXPECT_EQ(bare.intensity, map.intensity);
   EXPECT_TRUE(bare.normals.empty());
 
   prepareMap(map, 0.6);
-  writePointMap(path("normals.pcd"), map);
-  const PointMap with_normals = readPointMap(path("normals.pcd"));
+  writeMapPcd(path("normals.pcd"), map);
+  const MapCloud with_normals = readMapPcd(path("normals.pcd"));
   EXPECT_EQ(with_normals.normals, map.normals);
 }
 
@@ -117,12 +117,12 @@ TEST_F(MapFile, SomeNormalFieldsButNotAllIsAnError) {
   file << "VERSION .7\nFIELDS x y z normal_x\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 1\nHEIGHT 1\n"
           "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3 1\n";
   file.close();
-  EXPECT_THROW(readPointMap(path("partial.pcd")), IoError);
-  EXPECT_THROW(readPointMap(path("missing.pcd")), IoError);
+  EXPECT_THROW(readMapPcd(path("partial.pcd")), IoError);
+  EXPECT_THROW(readMapPcd(path("missing.pcd")), IoError);
 }
 
 // Pixels of the rendered range image that hold a point, all on the wall.
-size_t renderedWallPixels(const Config& config, const std::shared_ptr<PointMap>& map, size_t floor_points) {
+size_t renderedWallPixels(const Config& config, const std::shared_ptr<MapCloud>& map, size_t floor_points) {
   std::unique_ptr<Backend> backend = makeBackend(config);
   EXPECT_TRUE(backend->rendersMaps());
   backend->setMap(map);
@@ -151,7 +151,7 @@ size_t renderedWallPixels(const Config& config, const std::shared_ptr<PointMap>&
 TEST(MapRendering, WallGoesToTheRangeImageAndFloorToTheBevMap) {
   Config config;
   config.runtime.threads = 2;
-  auto map = std::make_shared<PointMap>();
+  auto map = std::make_shared<MapCloud>();
   addFloor(*map, 30.0, 0.2, 0.0);
   const size_t floor_points = map->size();
   addWall(*map, 10.0, 16.0, 4.0, 0.2);

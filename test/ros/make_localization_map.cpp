@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "../localization/shared_world.hpp"
-#include "elo/io/pcd.hpp"
+#include "elo/io/map_pcd.hpp"
 #include "elo/io/sequence.hpp"
 
 int main(int argc, char** argv) {
@@ -15,11 +15,11 @@ int main(int argc, char** argv) {
   try {
     const elo::Sequence sequence(argv[1]);
     const std::vector<Eigen::Isometry3d>& truth = sequence.groundTruth();
-    elo::PointMap map = elo::test::mapOfScans(
+    elo::MapCloud map = elo::test::mapOfScans(
         [&](int frame) { return std::make_pair(sequence.load(static_cast<size_t>(frame)), truth[static_cast<size_t>(frame)]); },
         static_cast<int>(truth.size()), 2, 0.2, elo::Config().localization.normal_radius);
     map.normals.clear();
-    elo::writePointMap(argv[2], map);
+    elo::writeMapPcd(argv[2], map);
     std::printf("wrote %zu map points to %s\n", map.size(), argv[2]);
     return 0;
   } catch (const std::exception& error) {

@@ -5,7 +5,6 @@
 #include <cstddef>
 #include <string>
 
-#include "elo/localization/point_map.hpp"
 #include "elo/types.hpp"
 
 namespace elo {
@@ -21,13 +20,5 @@ PointCloud readPcd(const std::string& path, size_t* non_finite_skipped = nullptr
 // Binary PCD with x y z intensity (float32), plus `ring` (uint16) and `time` (float32 s) when the
 // cloud has them.
 void writePcd(const std::string& path, const PointCloud& cloud);
-
-// A map for localization in its own frame: x, y, z (float32 or float64), and when present `intensity`
-// and the three fields normal_x, normal_y, normal_z (floating point). Points with a non-finite
-// coordinate are left for prepareMap() to drop and count. A malformed file throws IoError.
-PointMap readPointMap(const std::string& path);
-
-// Binary PCD with x y z intensity, and normal_x normal_y normal_z when the map has normals (float32).
-void writePointMap(const std::string& path, const PointMap& map);
 
 }  // namespace elo

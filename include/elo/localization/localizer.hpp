@@ -65,7 +65,7 @@ class Localizer {
  public:
   // Localizes `odometry`'s scans in `map` (prepared: with normals). Throws std::runtime_error when the
   // odometry's backend cannot render maps, std::invalid_argument for an empty map.
-  Localizer(Odometry& odometry, std::shared_ptr<const PointMap> map);
+  Localizer(Odometry& odometry, std::shared_ptr<const MapCloud> map);
 
   // The sensor's pose in the map near the next scan: that scan searches around it (localization.search_*
   // unless `radius` / `yaw_deg` are given) and takes the best match only if it is acceptable. A hint's z
@@ -83,7 +83,7 @@ class Localizer {
 
   LocalizationState state() const { return state_; }
   const Eigen::Isometry3d& mapFromOdom() const { return map_from_odom_; }
-  const PointMap& map() const { return *map_; }
+  const MapCloud& map() const { return *map_; }
   size_t acceptedCount() const { return accepted_; }
   size_t refusedCount() const { return refused_; }
   size_t relocalizationCount() const { return relocalized_; }
@@ -113,7 +113,7 @@ class Localizer {
 
   Odometry& odometry_;
   Config config_;
-  std::shared_ptr<const PointMap> map_;
+  std::shared_ptr<const MapCloud> map_;
   MapTiles tiles_;
   std::vector<int32_t> nearby_;
   LocalizationState state_ = LocalizationState::waiting_for_pose;

@@ -1,5 +1,6 @@
-// A saved map for localization: points in the map frame with their normals, and the tile index that
-// finds the points within sensor range of a position, so that a map match renders only those.
+// A saved map made ready for localization (a MapCloud in the map frame, its normals estimated at load
+// when the file had none), and the tile index that finds the points within sensor range of a position,
+// so that a map match renders only those.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,20 +9,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "elo/types.hpp"
+#include "elo/map_cloud.hpp"
 
 namespace elo {
-
-// Points of a map in its own frame (`map`). A normal is a unit vector, or zero where none could be fitted
-// (such a point still serves the ground term, which fits its own normals).
-struct PointMap {
-  std::vector<Vec3f> points;
-  std::vector<float> intensity;  // empty, or one per point
-  std::vector<Vec3f> normals;    // empty (none known yet), or one per point
-
-  size_t size() const { return points.size(); }
-  bool hasNormals() const { return normals.size() == points.size() && !points.empty(); }
-};
 
 // What cleaning a loaded map did: points dropped for a non-finite coordinate, normals that were not unit
 // vectors and were set to zero, normals estimated because the file had none.
@@ -35,16 +25,16 @@ struct MapPreparation {
 // Drops non-finite points, zeroes normals that are not unit vectors, and estimates the normals when the
 // map has none: each point's from the plane through its neighbours within `normal_radius` (at least 5 of
 // them, and planar: the smallest eigenvalue under a tenth of the sum). Done once, at load.
-MapPreparation prepareMap(PointMap& map, double normal_radius);
+MapPreparation prepareMap(MapCloud& map, double normal_radius);
 
 // The normal of every point from its neighbours within `radius` (zero where they give no plane). Its sign
 // is arbitrary: each render turns the normals towards the sensor, as the scan's face it.
-void estimateMapNormals(PointMap& map, double radius);
+void estimateMapNormals(MapCloud& map, double radius);
 
 // Square tiles of the map's x-y plane, `tile_size` wide, each listing its points.
 class MapTiles {
  public:
-  MapTiles(const PointMap& map, double tile_size);
+  MapTiles(const MapCloud& map, double tile_size);
 
   // The points within `radius` (in x-y) of `center`, appended to `out` in tile order.
   void pointsNear(const Eigen::Vector3d& center, double radius, std::vector<int32_t>& out) const;
@@ -55,7 +45,7 @@ class MapTiles {
 
  private:
   static uint64_t key(int64_t col, int64_t row);
-  const PointMap& map_;
+  const MapCloud& map_;
   double tile_size_;
   std::unordered_map<uint64_t, std::vector<int32_t>> tiles_;
   Eigen::Vector2d lower_ = Eigen::Vector2d::Zero();

@@ -151,7 +151,7 @@ void CpuBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float sta
   model_.initialized = true;
 }
 
-void CpuBackend::setMap(std::shared_ptr<const PointMap> map) {
+void CpuBackend::setMap(std::shared_ptr<const MapCloud> map) {
   if (map && !map->hasNormals() && map->size() > 0) throw std::invalid_argument("the map has no normals (prepareMap())");
   map_ = std::move(map);
   map_scratch_.closest.resize(scan_.image.pixelCount());

@@ -26,7 +26,7 @@ class CpuBackend final : public Backend {
   const Model& model() override { return model_; }
 
   bool rendersMaps() const override { return true; }
-  void setMap(std::shared_ptr<const PointMap> map) override;
+  void setMap(std::shared_ptr<const MapCloud> map) override;
   void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) override;
   NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) override;
   const Model& mapModel() override { return map_model_; }
@@ -64,7 +64,7 @@ class CpuBackend final : public Backend {
   GroundNormalCache ground_normals_;
 
   // Localization (renderMap()): the map, the model last rendered from it and their scratch.
-  std::shared_ptr<const PointMap> map_;
+  std::shared_ptr<const MapCloud> map_;
   Model map_model_;
   MapRenderScratch map_scratch_;
   GroundNormalCache map_ground_normals_;

@@ -45,7 +45,7 @@ void splat(const SphericalProjection& projection, int row, int col, float range,
 
 }  // namespace
 
-void renderMapModel(const PointMap& map, const std::vector<int32_t>& points, const Rigid3f& sensor_from_map,
+void renderMapModel(const MapCloud& map, const std::vector<int32_t>& points, const Rigid3f& sensor_from_map,
                     const SphericalProjection& spherical, const BevProjection& bev, const MapRendering& rendering,
                     MapRenderScratch& scratch, Model& model) {
   const size_t count = points.size();

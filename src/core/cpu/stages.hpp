@@ -193,7 +193,7 @@ struct MapRendering {
 // Renders `points` of `map` (which has normals) moved by `sensor_from_map` into `model`: the non-ground
 // points with a normal into its range image, closest wins per pixel, each covering the pixels its disc
 // spans (normals turned towards the sensor); the ground points into its BEV map.
-void renderMapModel(const PointMap& map, const std::vector<int32_t>& points, const Rigid3f& sensor_from_map,
+void renderMapModel(const MapCloud& map, const std::vector<int32_t>& points, const Rigid3f& sensor_from_map,
                     const SphericalProjection& spherical, const BevProjection& bev, const MapRendering& rendering,
                     MapRenderScratch& scratch, Model& model);
 

@@ -61,7 +61,7 @@ std::vector<Eigen::Isometry3d> searchOffsets(const PoseHint& hint, const Localiz
   return offsets;
 }
 
-std::shared_ptr<const PointMap> checkedMap(std::shared_ptr<const PointMap> map) {
+std::shared_ptr<const MapCloud> checkedMap(std::shared_ptr<const MapCloud> map) {
   if (!map || map->size() == 0) throw std::invalid_argument("the map is empty");
   if (!map->hasNormals()) throw std::invalid_argument("the map has no normals (prepareMap() estimates them)");
   return map;
@@ -81,7 +81,7 @@ const char* stateName(LocalizationState state) {
   return "unknown";
 }
 
-Localizer::Localizer(Odometry& odometry, std::shared_ptr<const PointMap> map)
+Localizer::Localizer(Odometry& odometry, std::shared_ptr<const MapCloud> map)
     : odometry_(odometry),
       config_(odometry.config()),
       map_(checkedMap(std::move(map))),

@@ -82,14 +82,14 @@ bool isUnit(const Vec3f& normal) { return std::abs(normal.squaredNorm() - 1.0f) 
 
 }  // namespace
 
-void estimateMapNormals(PointMap& map, double radius) {
+void estimateMapNormals(MapCloud& map, double radius) {
   const VoxelIndex index(map.points, radius);
   map.normals.assign(map.points.size(), Vec3f::Zero());
   tbb::parallel_for(size_t{0}, map.points.size(),
                     [&](size_t i) { map.normals[i] = fitNormal(index, map.points, map.points[i]); });
 }
 
-MapPreparation prepareMap(PointMap& map, double normal_radius) {
+MapPreparation prepareMap(MapCloud& map, double normal_radius) {
   MapPreparation preparation;
   const bool had_normals = map.normals.size() == map.points.size();
   const bool had_intensity = map.intensity.size() == map.points.size();
@@ -124,7 +124,7 @@ MapPreparation prepareMap(PointMap& map, double normal_radius) {
   return preparation;
 }
 
-MapTiles::MapTiles(const PointMap& map, double tile_size) : map_(map), tile_size_(tile_size) {
+MapTiles::MapTiles(const MapCloud& map, double tile_size) : map_(map), tile_size_(tile_size) {
   if (map.points.empty()) return;
   lower_ = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   upper_ = -lower_;
