@@ -119,7 +119,7 @@ sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Head
   message.header = header;
   message.height = 1;
   message.width = static_cast<uint32_t>(map.size());
-  message.is_bigendian = hostIsBigEndian();
+  message.is_bigendian = elo::hostIsBigEndian();
   message.is_dense = true;
   const char* names[] = {"x", "y", "z", "intensity"};
   for (int i = 0; i < 4; ++i) {
