@@ -13,8 +13,9 @@
 
 namespace elo {
 
-// What cleaning a loaded map did: points dropped for a non-finite coordinate, normals that were not unit
-// vectors and were set to zero, normals estimated because the file had none.
+// What cleaning a loaded map did: points dropped for a non-finite coordinate (readMapPcd() skips them
+// before prepareMap() sees them: the loaders add its count here), normals that were not unit vectors and
+// were set to zero, normals estimated because the file had none.
 struct MapPreparation {
   size_t non_finite_dropped = 0;
   size_t bad_normals = 0;
