@@ -64,7 +64,12 @@ void renderMapModel(const MapCloud& map, const std::vector<int32_t>& points, con
     if (isGround(vertex, normal, rendering)) {
       int row = 0;
       int col = 0;
-      if (bev.cellOf(vertex, row, col)) offers[i] = GroundOffer(row * bev.cols + col, toVec3f(vertex), 0.0f, static_cast<uint32_t>(i));
+      // A map has no observation times: the height above the band's floor stands in for the age, so that
+      // of the points on one surface in a cell (the fill's second round) the lowest, the ground rather
+      // than a wall's foot, wins, whatever the tie-break among equal ages would pick.
+      if (bev.cellOf(vertex, row, col)) {
+        offers[i] = GroundOffer(row * bev.cols + col, toVec3f(vertex), vertex.z - rendering.ground_low, static_cast<uint32_t>(i));
+      }
       return;
     }
     if (isZero(normal)) return;
