@@ -22,7 +22,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
 
-.PHONY: deps build test test-long compat test-sanitize test-asan test-tsan test-baseline test-aarch64 deps-aarch64 fuzz \
+.PHONY: deps build test test-long compat compat-poses test-sanitize test-asan test-tsan test-baseline test-aarch64 deps-aarch64 fuzz \
   bench demo accuracy soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
@@ -36,10 +36,12 @@ deps:
 # The CUDA backend is built when nvcc is found: on PATH, or where the CUDA toolkit installs it.
 NVCC ?= $(shell command -v nvcc || ls /usr/local/cuda/bin/nvcc 2>/dev/null)
 
+# CMAKE_ARGS: more options for the configure step (make compat builds with -DELO_NATIVE=OFF).
+CMAKE_ARGS ?=
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_SHARED_DATA=$(SHARED_DATA) \
 	  -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-	  $(if $(NVCC),-DCMAKE_CUDA_COMPILER=$(NVCC))
+	  $(if $(NVCC),-DCMAKE_CUDA_COMPILER=$(NVCC)) $(CMAKE_ARGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # Every test but the long simulated drives (labelled long, test/CMakeLists.txt), which test-long runs.
@@ -81,17 +83,21 @@ test-tsan: deps
 
 # The core's tests in a baseline x86-64 build (ELO_NATIVE=OFF: SSE2, so the scalar code instead of the
 # AVX lanes, and no FMA), then its poses on the shared real scans against the -march=native build's
-# (tools/same_poses.sh). Only what those need is built. Without FMA, fusedMultiplyAdd() and Eigen round
-# twice where the native build rounds once, so the poses differ in the last bits, which ICP carries to
-# at most 0.9 mm over the 60 scans: the bound is about twice that (docs/platforms.md).
+# (tools/poses_of.sh, tools/same_poses.sh). Only what those need is built. Without FMA, fusedMultiplyAdd()
+# and Eigen round twice where the native build rounds once, so the poses differ in the last bits, which
+# ICP carries to at most 0.9 mm over the 60 scans: the bound is about twice that (docs/platforms.md).
+# CI builds the baseline on Debian 11 instead (make compat COMPAT_TARGETS=core, then compat-poses).
 BASELINE_BUILD ?= build-baseline
 BASELINE_POSE_BOUND ?= 0.002
+REAL_SCANS := $(SHARED_DATA)/real/hdl64_drive_a
 test-baseline: build
 	cmake -S . -B $(BASELINE_BUILD) -DCMAKE_BUILD_TYPE=Release -DELO_NATIVE=OFF -DELO_CUDA=OFF \
 	  -DELO_SHARED_DATA=$(SHARED_DATA) -DPython3_EXECUTABLE=/usr/bin/python3 -DPYTHON_EXECUTABLE=/usr/bin/python3
 	cmake --build $(BASELINE_BUILD) --target test_core test_fault_cases test_backend_agreement elo_run -j$(JOBS)
 	cd $(BASELINE_BUILD) && ctest --output-on-failure -L '^core$$' -j$(JOBS)
-	tools/same_poses.sh $(BUILD) $(BASELINE_BUILD) $(SHARED_DATA)/real/hdl64_drive_a $(BASELINE_POSE_BOUND)
+	tools/poses_of.sh $(BUILD) $(REAL_SCANS) $(BUILD)/poses
+	tools/poses_of.sh $(BASELINE_BUILD) $(REAL_SCANS) $(BASELINE_BUILD)/poses
+	tools/same_poses.sh $(BUILD)/poses $(BASELINE_BUILD)/poses $(BASELINE_POSE_BOUND)
 
 # The ROS-free core and its tests cross-built for 64-bit ARM (cmake/aarch64-linux-gnu.cmake: Debian's
 # cross compiler and arm64 multiarch packages, ELO_CORE_ONLY) and run under qemu-user. Emulated code runs
@@ -130,12 +136,19 @@ gpu-check: build
 	tools/gpu_check.sh $(BUILD)/devel/lib/elo_odometry $(SHARED_DATA)/real/hdl64_drive_a
 
 # The package built and tested on Debian 11 (bullseye, the nearest twin of Noetic's Ubuntu 20.04) in a
-# debootstrap chroot cached in .compat/ (tools/compat.sh; root or sudo). COMPAT_TARGETS=core builds
-# everything and runs the core tests only, as CI does; COMPAT_TARGETS=deps only makes the chroot and
-# installs its packages (CI does that first, in the background).
+# debootstrap chroot cached in .compat/ (tools/compat.sh; root or sudo). COMPAT_TARGETS=core, as CI runs
+# it, builds everything as a baseline x86-64 build, runs the core tests only and writes the poses that
+# compat-poses compares; COMPAT_TARGETS=deps only makes the chroot and installs its packages (CI does
+# that first, in the background).
 COMPAT_TARGETS ?= test
 compat:
 	tools/compat.sh $(COMPAT_TARGETS)
+
+# The poses that `make compat COMPAT_TARGETS=core` left in .compat/poses (Debian 11's baseline x86-64
+# build: GCC 10, Eigen 3.3, no AVX, no FMA) against this machine's -march=native build's.
+compat-poses: build
+	tools/poses_of.sh $(BUILD) $(REAL_SCANS) $(BUILD)/poses
+	tools/same_poses.sh $(BUILD)/poses $(or $(COMPAT_CACHE),.compat)/poses $(BASELINE_POSE_BOUND)
 
 # The built-in default: a simulated 1 km urban HDL-64E drive, scored against its exact ground truth, then
 # replayed from a bag through the ROS node. DEMO_FRAMES=60 makes it short; see tools/demo.sh.

@@ -4,8 +4,10 @@
 # would track: no build directories), with the `make deps` and `make` targets a user runs. Root only (it
 # mounts; sudo is used when not root). Usage:
 #   tools/compat.sh [MAKE_TARGET... | core]
-# MAKE_TARGET defaults to `test`. `core` builds everything and runs the core tests only (ctest -L core):
-# CI's share of the run. Environment: COMPAT_CACHE (default .compat/ in the tree, ignored by git: the
+# MAKE_TARGET defaults to `test`. `core` is CI's share of the run: everything built as a baseline x86-64
+# build (-DELO_NATIVE=OFF: no AVX, no FMA), the core tests (ctest -L core), and elo_run's poses on the
+# shared real scans written to COMPAT_CACHE/poses (tools/poses_of.sh), which `make compat-poses` compares
+# with this machine's -march=native build's. Environment: COMPAT_CACHE (default .compat/ in the tree, ignored by git: the
 # chroot, kept between runs so that a second run needs no download), COMPAT_MIRROR (default Debian's,
 # deb.debian.org), JOBS (default nproc). The shared data (../shared/data) is mounted read-only when present.
 set -euo pipefail
@@ -104,8 +106,10 @@ step "make deps (installs what bullseye lacks; nothing on a cached chroot)"
 in_chroot "apt-get update -qq && make deps"
 
 if [ "${targets[*]}" = core ]; then
-  step "make build, then ctest -L core"
-  in_chroot --isolated "make build JOBS=$jobs && cd build && ctest --output-on-failure -L core -j$jobs"
+  step "make build CMAKE_ARGS=-DELO_NATIVE=OFF, ctest -L core, the poses on the real scans"
+  in_chroot --isolated "make build JOBS=$jobs CMAKE_ARGS=-DELO_NATIVE=OFF && (cd build && ctest --output-on-failure -L core -j$jobs) && tools/poses_of.sh build ../shared/data/real/hdl64_drive_a build/poses"
+  rm -rf "$cache/poses"
+  cp -r "$chroot_dir$src/build/poses" "$cache/poses"
 else
   step "make ${targets[*]}"
   in_chroot --isolated "make ${targets[*]} JOBS=$jobs"
