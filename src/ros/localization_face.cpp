@@ -69,7 +69,7 @@ LocalizationFace::LocalizationFace(ros::NodeHandle& node, ros::NodeHandle& priva
   std_msgs::Header header;
   header.frame_id = settings.map_frame;
   header.stamp = ros::Time::now();
-  map_publisher_.publish(localizationMapCloud(localizer_->map(), kMapDisplayPoints, header));
+  map_publisher_.publish(mapCloud(localizer_->map(), kMapDisplayPoints, header));
   initial_pose_subscriber_ = node.subscribe("/initialpose", 1, &LocalizationFace::onInitialPose, this);
   relocalize_service_ = private_node.advertiseService("relocalize", &LocalizationFace::onRelocalize, this);
 }

@@ -94,15 +94,6 @@ sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_
   return cloud.finish();
 }
 
-sensor_msgs::PointCloud2 localizationMapCloud(const elo::MapCloud& map, size_t max_points,
-                                              const std_msgs::Header& header) {
-  VertexCloud cloud(header, false);
-  const size_t stride = max_points > 0 && map.size() > max_points ? (map.size() + max_points - 1) / max_points : 1;
-  cloud.reserve(map.size() / stride + 1);
-  for (size_t i = 0; i < map.size(); i += stride) cloud.add(map.points[i]);
-  return cloud.finish();
-}
-
 sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::PixelLabel label,
                                            const std_msgs::Header& header) {
   const bool with_normals = label == elo::PixelLabel::nonground;
@@ -114,11 +105,13 @@ sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::Pixe
   return cloud.finish();
 }
 
-sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Header& header) {
+sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, size_t max_points, const std_msgs::Header& header) {
+  const size_t stride = max_points > 0 && map.size() > max_points ? (map.size() + max_points - 1) / max_points : 1;
+  const size_t count = (map.size() + stride - 1) / stride;
   sensor_msgs::PointCloud2 message;
   message.header = header;
   message.height = 1;
-  message.width = static_cast<uint32_t>(map.size());
+  message.width = static_cast<uint32_t>(count);
   message.is_bigendian = elo::hostIsBigEndian();
   message.is_dense = true;
   const char* names[] = {"x", "y", "z", "intensity"};
@@ -133,10 +126,11 @@ sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Head
   message.point_step = 4 * sizeof(float);
   message.row_step = message.point_step * message.width;
   message.data.resize(message.row_step);
-  for (size_t i = 0; i < map.size(); ++i) {
+  for (size_t n = 0; n < count; ++n) {
+    const size_t i = n * stride;
     const float values[4] = {map.points[i].x(), map.points[i].y(), map.points[i].z(),
                              i < map.intensity.size() ? map.intensity[i] : 0.0f};
-    std::memcpy(message.data.data() + i * message.point_step, values, sizeof(values));
+    std::memcpy(message.data.data() + n * message.point_step, values, sizeof(values));
   }
   return message;
 }

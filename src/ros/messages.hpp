@@ -24,18 +24,14 @@ sensor_msgs::PointCloud2 nonGroundModelCloud(const elo::SphericalImage& model, c
 // normals: the registration fits them from neighbouring cells only where a scan point associates.
 sensor_msgs::PointCloud2 groundModelCloud(const elo::BevImage& model, const std_msgs::Header& header);
 
-// A saved map's points as x y z, float32: every point, or every n-th where the map has more than
-// `max_points` (0: no limit), for rviz.
-sensor_msgs::PointCloud2 localizationMapCloud(const elo::MapCloud& map, size_t max_points,
-                                              const std_msgs::Header& header);
-
 // The scan's pixels carrying `label`; non-ground pixels with their normals (as nonGroundModelCloud),
 // ground pixels as x y z.
 sensor_msgs::PointCloud2 labelledScanCloud(const elo::ScanImage& scan, elo::PixelLabel label,
                                            const std_msgs::Header& header);
 
-// A map for display (the drive's): x y z intensity (0 where it has none), float32, one point per map point.
-sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, const std_msgs::Header& header);
+// A map for display (the drive's, or a saved one localized in): x y z intensity (0 where it has none),
+// float32; every point, or every n-th where the map has more than `max_points` (0: no limit).
+sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, size_t max_points, const std_msgs::Header& header);
 
 // The model as one point list for elo::writePcd, moved by `transform` (sensor -> odom frame).
 elo::PointCloud modelPoints(const elo::Model& model, const Eigen::Isometry3d& transform);

@@ -249,7 +249,8 @@ void OdometryNodelet::publishMap(const elo::DriveMap& map, const elo::MapScan& s
   std_msgs::Header header;
   header.stamp.fromSec(scan.stamp);
   header.frame_id = settings_.odom_frame;
-  map_publisher_.publish(mapCloud(map.points((map.voxelCount() + limit - 1) / limit), header));
+  // Thinned by the map itself, which then copies only the points shown.
+  map_publisher_.publish(mapCloud(map.points((map.voxelCount() + limit - 1) / limit), 0, header));
 }
 
 void OdometryNodelet::reportRestart(const elo::FrameResult& result, double stamp) {

@@ -1,37 +1,24 @@
 // The elo_eval command line, run as a user runs it.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "../io/temp_directory.hpp"
 #include "../io/test_helpers.hpp"
+#include "../tools/run_command.hpp"
 #include "elo/io/kitti.hpp"
 #include "synthetic_trajectories.hpp"
 
 namespace elo {
 namespace {
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using test::CommandResult;
+using test::contains;
 
 CommandResult runEloEval(const std::string& arguments) {
-  CommandResult result;
-  FILE* pipe = popen((std::string(ELO_EVAL_BINARY) + " " + arguments + " 2>&1").c_str(), "r");
-  char buffer[4096];
-  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-bool contains(const std::string& text, const std::string& fragment) {
-  return text.find(fragment) != std::string::npos;
+  return test::runCommand(std::string(ELO_EVAL_BINARY) + " " + arguments);
 }
 
 class EloEvalCli : public testing::Test {

@@ -8,25 +8,7 @@
 #include "elo/io/cdr_point_cloud2.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/point_cloud2.hpp"
-#include "fuzz_support.hpp"
-
-namespace {
-
-bool emptyOrOnePerPoint(size_t channel_size, size_t points) { return channel_size == 0 || channel_size == points; }
-
-void expectConsistent(const elo::ConvertedCloud& converted, const elo::PointCloud2View& message) {
-  using elo::fuzz::expectProperty;
-  const elo::PointCloud& cloud = converted.cloud;
-  expectProperty(!cloud.points.empty(), "a usable cloud has points");
-  for (const elo::Vec3f& point : cloud.points) expectProperty(point.allFinite(), "only finite points");
-  expectProperty(emptyOrOnePerPoint(cloud.intensity.size(), cloud.size()), "intensity empty or one per point");
-  expectProperty(emptyOrOnePerPoint(cloud.ring.size(), cloud.size()), "ring empty or one per point");
-  expectProperty(emptyOrOnePerPoint(cloud.time.size(), cloud.size()), "time empty or one per point");
-  expectProperty(cloud.size() + converted.non_finite_points == static_cast<size_t>(message.width) * message.height,
-                 "every point converted or counted as non-finite");
-}
-
-}  // namespace
+#include "converted_cloud_properties.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using elo::fuzz::expectProperty;
@@ -41,11 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const double stamp = elo::decodeCdrStamp(data, size);
   expectProperty(stamp == message.stamp || (std::isnan(stamp) && std::isnan(message.stamp)),
                  "the stamp read alone is the message's");
-  const elo::ConvertedCloud converted = elo::convertPointCloud2(message);
-  if (converted.usable()) {
-    expectConsistent(converted, message);
-  } else {
-    expectProperty(!converted.detail.empty(), "a rejection says why");
-  }
+  elo::fuzz::expectConvertedOrRejected(elo::convertPointCloud2(message),
+                                       static_cast<size_t>(message.width) * message.height);
   return 0;
 }

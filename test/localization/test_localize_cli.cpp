@@ -2,13 +2,13 @@
 // other scan in the frame of its first (the frame elo_run --map writes), and the drive localized in it
 // from the default initial pose and from a given one whose height comes from the map.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <limits>
 #include <string>
 
 #include "../io/temp_directory.hpp"
+#include "../tools/run_command.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/map_pcd.hpp"
 #include "elo/sim/sequence_writer.hpp"
@@ -18,21 +18,6 @@ namespace elo::test {
 namespace {
 
 constexpr int kFrames = 40;
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandResult runCommand(const std::string& command) {
-  CommandResult result;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  char buffer[4096];
-  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 class LocalizeCli : public testing::Test {
  protected:

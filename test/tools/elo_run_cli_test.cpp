@@ -5,7 +5,6 @@
 // writer) gives the directory's poses bit for bit; malformed, truncated and empty bags are clear errors or
 // counted skips that keep the poses computed so far.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +16,7 @@
 #include <rosbag/bag.h>
 
 #include "../io/ros2_bag_writer.hpp"
+#include "run_command.hpp"
 #include "../io/temp_directory.hpp"
 #include "cloud_conversion.hpp"
 #include "elo/io/kitti.hpp"
@@ -29,22 +29,9 @@ namespace fs = std::filesystem;
 
 constexpr size_t kScans = 6;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CommandResult runCommand(const std::string& command) {
-  CommandResult result;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  char buffer[4096];
-  for (size_t read; (read = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) result.output.append(buffer, read);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-bool contains(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
+using elo::test::CommandResult;
+using elo::test::contains;
+using elo::test::runCommand;
 
 std::vector<std::string> lines(const std::string& path) {
   std::vector<std::string> result;
