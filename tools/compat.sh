@@ -7,9 +7,10 @@
 # MAKE_TARGET defaults to `test`. `core` is CI's share of the run: everything built as a baseline x86-64
 # build (-DELO_NATIVE=OFF: no AVX, no FMA), the core tests (ctest -L core), and elo_run's poses on the
 # shared real scans written to COMPAT_CACHE/poses (tools/poses_of.sh), which `make compat-poses` compares
-# with this machine's -march=native build's. Environment: COMPAT_CACHE (default .compat/ in the tree, ignored by git: the
-# chroot, kept between runs so that a second run needs no download), COMPAT_MIRROR (default Debian's,
-# deb.debian.org), JOBS (default nproc). The shared data (../shared/data) is mounted read-only when present.
+# with this machine's -march=native build's. Environment: COMPAT_CACHE (default .compat/ in the tree,
+# ignored by git: the chroot, kept between runs so that a second run needs no download), COMPAT_MIRROR
+# (default Debian's, deb.debian.org), JOBS (default nproc). The shared data (../shared/data) is mounted
+# read-only when present.
 set -euo pipefail
 tree="$(cd "$(dirname "$0")/.." && pwd)"
 cache=${COMPAT_CACHE:-$tree/.compat}

@@ -16,9 +16,9 @@
 #include <rosbag/bag.h>
 
 #include "../io/ros2_bag_writer.hpp"
-#include "run_command.hpp"
 #include "../io/temp_directory.hpp"
 #include "cloud_conversion.hpp"
+#include "run_command.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/pcd.hpp"
 #include "elo/io/sequence.hpp"
