@@ -11,7 +11,7 @@ std::vector<std::string> sensorNames() {
   return {"hdl64",    "vlp16",     "vlp32", "vls128", "hdl32",                          // Velodyne
           "os0-64",   "os0-128",   "os1-64", "os1-128", "os2-64", "os2-128",            // Ouster
           "pandar64", "pandar40p", "xt16", "xt32", "xt32m", "ot128", "qt64", "qt128",   // Hesai
-          "helios16"};                                                                  // RoboSense
+          "helios16", "helios5515", "rubyplus", "bpearl"};                              // RoboSense
 }
 
 void loadSensor(const std::string& name, Config& config) {
