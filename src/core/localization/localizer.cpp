@@ -54,11 +54,19 @@ std::vector<Eigen::Isometry3d> searchOffsets(const PoseHint& hint, const Localiz
       }
     }
   }
-  std::stable_sort(offsets.begin(), offsets.end(), [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
-    return a.translation().norm() + Eigen::AngleAxisd(a.rotation()).angle() <
-           b.translation().norm() + Eigen::AngleAxisd(b.rotation()).angle();
-  });
-  return offsets;
+  // Nearest first, sorted by index: std::stable_sort's scratch buffer (libstdc++'s temporary buffer) is
+  // allocated without the 32-byte alignment an Isometry3d's AVX loads need, and sorting the offsets
+  // themselves crashed on Debian 11 (GCC 10, Eigen 3.3).
+  std::vector<std::pair<double, size_t>> order;
+  order.reserve(offsets.size());
+  for (size_t i = 0; i < offsets.size(); ++i) {
+    order.emplace_back(offsets[i].translation().norm() + Eigen::AngleAxisd(offsets[i].rotation()).angle(), i);
+  }
+  std::sort(order.begin(), order.end());  // ties in the offsets' order, as a stable sort leaves them
+  std::vector<Eigen::Isometry3d> nearest_first;
+  nearest_first.reserve(offsets.size());
+  for (const auto& [distance, index] : order) nearest_first.push_back(offsets[index]);
+  return nearest_first;
 }
 
 std::shared_ptr<const MapCloud> checkedMap(std::shared_ptr<const MapCloud> map) {
