@@ -321,8 +321,9 @@ void writeTrajectory(const Options& options, const elo::ScanSource& source, cons
   if (!options.tum_output.empty()) elo::writeTumPoses(options.tum_output, trajectory.stamps, trajectory.poses);
 }
 
-// The drive's map (--map): every processed scan that registered in every direction is handed to the
-// map's thread; the map is written when the run ends, or fails part-way.
+// The drive's map (--map): of the processed scans that registered in every direction, those the map
+// takes (map.scan_stride) are handed to the map's thread; the map is written when the run ends, or
+// fails part-way.
 class MapOutput {
  public:
   MapOutput(const std::string& path, const elo::MapConfig& config)
@@ -331,10 +332,12 @@ class MapOutput {
   void add(elo::Odometry& odometry, const elo::FrameResult& result, const elo::PointCloud& cloud) {
     if (result.reset) builder_.clear();  // the poses before the reset lie in another frame
     if (!result.processed) return;
+    ++processed_;
     if (result.registration.degeneracy.any()) {
       ++degenerate_;
       return;
     }
+    if (!builder_.takesNextScan()) return;
     const double start = elo::threadCpuSeconds();
     elo::MapScan scan = elo::mapScanOf(odometry.backend().scan(), cloud, odometry.modelPose(), cloud.stamp,
                                        odometry.config().map.voxel_size);
@@ -356,10 +359,11 @@ class MapOutput {
     return text;
   }
 
-  // CPU milliseconds a scan: copying its points on the odometry's thread, and adding them on the map's.
+  // CPU milliseconds a processed scan, taken by the map or not: copying points on the odometry's thread,
+  // and adding them on the map's.
   std::pair<double, double> costPerScan() {
     const elo::MapBuilder::Statistics statistics = builder_.statistics();
-    const double scans = std::max<double>(statistics.scans, 1.0);
+    const double scans = std::max<double>(processed_, 1.0);
     return {1000.0 * copy_seconds_ / scans, 1000.0 * statistics.busy_seconds / scans};
   }
 
@@ -368,6 +372,7 @@ class MapOutput {
   static constexpr size_t kMaxQueued = 32;
   std::string path_;
   elo::MapBuilder builder_;
+  size_t processed_ = 0;
   size_t degenerate_ = 0;
   double copy_seconds_ = 0.0;
 };
@@ -531,8 +536,8 @@ int run(const Options& options) {
     std::printf("%s\n", map->write().c_str());
     const auto [copy_ms, add_ms] = map->costPerScan();
     const double pipeline_ms = loop.report().meanTotalMilliseconds();
-    std::printf("map cost a scan (CPU time): %.2f ms copying its points (odometry's thread), %.2f ms adding them "
-                "(map's thread); the pipeline took %.1f ms (wall)\n", copy_ms, add_ms, pipeline_ms);
+    std::printf("map cost a processed scan (CPU time): %.2f ms copying points (odometry's thread), %.2f ms adding "
+                "them (map's thread); the pipeline took %.1f ms (wall)\n", copy_ms, add_ms, pipeline_ms);
   }
   if (localizer) loop.localizationReport().print(*localizer);
   return 0;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <unordered_map>
@@ -35,6 +36,20 @@ struct MapScan {
 // give every voxel a point: their points would only add to the same centroids.
 MapScan mapScanOf(const ScanImage& scan, const PointCloud& cloud, const Eigen::Isometry3d& pose, double stamp,
                   double voxel_size);
+
+// Which registered scans go into the map: every MapConfig::scan_stride-th, the first after a clear()
+// included.
+class MapScanSelection {
+ public:
+  explicit MapScanSelection(int stride) : stride_(static_cast<uint64_t>(std::max(stride, 1))) {}
+  // Call once for each registered scan: true when the map takes it.
+  bool takes() { return registered_++ % stride_ == 0; }
+  void clear() { registered_ = 0; }
+
+ private:
+  uint64_t stride_;
+  uint64_t registered_ = 0;
+};
 
 class DriveMap {
  public:

@@ -27,11 +27,14 @@ class MapBuilder {
   MapBuilder(const MapBuilder&) = delete;
   MapBuilder& operator=(const MapBuilder&) = delete;
 
+  // Whether the map takes the next registered scan (MapConfig::scan_stride): ask before copying it out.
+  bool takesNextScan();
   // Queues the scan; returns false (and counts it) when the queue is full.
   bool add(MapScan scan);
   // Waits until every scan queued so far is in the map, then returns its points (DriveMap::points()).
   MapCloud points();
-  // Forgets the map and the scans still queued: the odometry restarted at the origin.
+  // Forgets the map and the scans still queued, and counts the scans to take from the next one: the
+  // odometry restarted at the origin.
   void clear();
 
   struct Statistics {
@@ -50,6 +53,7 @@ class MapBuilder {
   std::unique_lock<std::mutex> drained();
 
   DriveMap map_;
+  MapScanSelection selection_;
   size_t max_queued_;
   AfterScan after_scan_;
   std::mutex mutex_;

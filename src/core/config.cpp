@@ -191,6 +191,8 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("map.voxel_size", c.map.voxel_size, "edge of a voxel of the drive's map, m (docs/map.md)"),
       bindField("map.min_observations", c.map.min_observations,
                 "scans that must see a non-ground voxel of the drive's map for it to be written (moving objects)"),
+      bindField("map.scan_stride", c.map.scan_stride,
+                "the drive's map takes every n-th registered scan; 1 = every scan (docs/map.md)"),
       bindChoice("runtime.backend", c.runtime.backend,
                  {{BackendKind::cpu, "cpu"}, {BackendKind::cuda, "cuda"}}, "compute backend"),
       bindField("runtime.backend_fallback", c.runtime.backend_fallback,
@@ -225,6 +227,7 @@ std::vector<Parameter> parameters(Config& c) {
 void validate(const MapConfig& map) {
   require(map.voxel_size >= 0.01 && map.voxel_size <= 10.0, "map.voxel_size", "must lie in [0.01, 10] m");
   require(map.min_observations >= 1 && map.min_observations <= 1000, "map.min_observations", "must lie in [1, 1000]");
+  require(map.scan_stride >= 1 && map.scan_stride <= 100, "map.scan_stride", "must lie in [1, 100]");
 }
 
 namespace {

@@ -7,7 +7,7 @@
 namespace elo {
 
 MapBuilder::MapBuilder(const MapConfig& config, size_t max_queued, AfterScan after_scan)
-    : map_(config), max_queued_(std::max<size_t>(max_queued, 1)), after_scan_(std::move(after_scan)),
+    : map_(config), selection_(config.scan_stride), max_queued_(std::max<size_t>(max_queued, 1)), after_scan_(std::move(after_scan)),
       thread_([this] { work(); }) {}
 
 MapBuilder::~MapBuilder() {
@@ -43,9 +43,15 @@ MapCloud MapBuilder::points() {
   return map_.points();
 }
 
+bool MapBuilder::takesNextScan() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return selection_.takes();
+}
+
 void MapBuilder::clear() {
   std::unique_lock<std::mutex> lock(mutex_);
   queue_.clear();
+  selection_.clear();
   changed_.wait(lock, [this] { return !adding_; });
   map_.clear();
 }

@@ -230,6 +230,7 @@ void OdometryNodelet::feedMap(const elo::FrameResult& result, const elo::PointCl
   if (!map_ || result.registration.degeneracy.any()) return;
   std::unique_lock<std::mutex> lock(odometry_mutex_);
   if (generation != map_generation_) return;  // ~reset since: the pose lies in the old odom frame
+  if (!map_->takesNextScan()) return;
   // Only this thread processes scans: the backend still holds this one.
   elo::MapScan scan = elo::mapScanOf(odometry_->backend().scan(), cloud, sensor_pose, cloud.stamp,
                                      odometry_->config().map.voxel_size);

@@ -145,6 +145,9 @@ TEST(DriveMap, RejectsAnUnusableConfig) {
   config = MapConfig{};
   config.min_observations = 0;
   EXPECT_THROW(DriveMap{config}, ConfigError);
+  config = MapConfig{};
+  config.scan_stride = 0;
+  EXPECT_THROW(DriveMap{config}, ConfigError);
 }
 
 TEST(MapScanOf, CopiesTheOccupiedPixelsWithIntensityLabelAndNormalsFacingTheSensor) {
@@ -196,6 +199,24 @@ TEST(MapBuilder, BuildsTheSameMapOnItsThread) {
   builder.clear();
   EXPECT_EQ(builder.points().size(), 0u);
   EXPECT_EQ(builder.statistics().scans, 0u);
+}
+
+// Every scan_stride-th registered scan, the first included, and the count starts again after a clear:
+// the first scan after the odometry restarted goes into the new map.
+TEST(MapBuilder, TakesEveryStrideThScanCountingAgainAfterAClear) {
+  MapConfig config = everyVoxel();
+  config.scan_stride = 3;
+  MapBuilder builder(config);
+  std::vector<bool> taken;
+  for (int i = 0; i < 7; ++i) taken.push_back(builder.takesNextScan());
+  EXPECT_EQ(taken, (std::vector<bool>{true, false, false, true, false, false, true}));
+  builder.clear();
+  EXPECT_TRUE(builder.takesNextScan());
+  EXPECT_FALSE(builder.takesNextScan());
+  config.scan_stride = 1;
+  MapBuilder every_scan(config);
+  EXPECT_TRUE(every_scan.takesNextScan());
+  EXPECT_TRUE(every_scan.takesNextScan());
 }
 
 TEST(MapBuilder, LeavesOutAndCountsAScanWhenItsQueueIsFull) {
