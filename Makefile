@@ -4,7 +4,7 @@
 # simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer +
 # UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer; `make fuzz` runs every libFuzzer
 # target for FUZZ_SECONDS (needs clang, which it installs); `make rviz-screenshot` replays a simulated
-# drive into rviz on a virtual screen and saves docs/rviz.png; `make gpu-check` checks and measures the
+# drive into rviz on a virtual screen and saves docs/rviz.png and docs/rviz_map.png; `make gpu-check` checks and measures the
 # CUDA backend on a GPU machine.
 SHELL := /bin/bash
 # catkin's CMake needs Debian's python (with catkin_pkg) ahead of any other python3 on PATH.
@@ -168,10 +168,11 @@ SOAK_RATE ?= 1
 soak: build
 	tools/soak.sh $(BUILD) $(SOAK_SCANS) $(SOAK_RATE)
 
-# docs/rviz.png: a simulated drive replayed into rviz on a virtual screen (docs/rviz.md).
+# docs/rviz.png and docs/rviz_map.png: a simulated drive replayed into rviz on a virtual screen (docs/rviz.md).
 rviz-screenshot: DEB_PACKAGES += xvfb netpbm
 rviz-screenshot: build
 	tools/rviz_screenshot.sh $(BUILD) docs/rviz.png
+	tools/rviz_screenshot.sh $(BUILD) docs/rviz_map.png "" rviz/elo_map.rviz
 
 clean:
 	rm -rf $(BUILD)

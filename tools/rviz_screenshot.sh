@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Replays a bag through elo_bag.launch with rviz:=true on a virtual screen (Xvfb, no display needed)
 # and saves what rviz shows once the bag has ended and the odometry has caught up. Usage:
-#   tools/rviz_screenshot.sh BUILD_DIR OUTPUT.png [BAG]
-# Without BAG it simulates a 20 s urban drive (elo_sim --bag) and replays that. Needs xvfb and netpbm
+#   tools/rviz_screenshot.sh BUILD_DIR OUTPUT.png [BAG] [RVIZ_CONFIG]
+# Without BAG (or with an empty one) it simulates a 20 s urban drive (elo_sim --bag) and replays that.
+# RVIZ_CONFIG defaults to rviz/elo.rviz (rviz/elo_map.rviz: the drive's map from above). Needs xvfb and netpbm
 # (make rviz-screenshot installs them). ELO_SCREENSHOT_WIDTH scales the picture (default 1200 pixels).
 set -euo pipefail
 build=${1:?usage: tools/rviz_screenshot.sh BUILD_DIR OUTPUT.png [BAG]}
 output=${2:?usage: tools/rviz_screenshot.sh BUILD_DIR OUTPUT.png [BAG]}
 bag=${3:-}
+rviz_config=$(realpath "${4:-$(dirname "$0")/../rviz/elo.rviz}")
 width=${ELO_SCREENSHOT_WIDTH:-1200}
 bin="$build/devel/lib/elo_odometry"
 for tool in Xvfb xwdtopnm pnmtopng rviz; do
@@ -53,6 +55,7 @@ source "$build/devel/setup.bash"
 set -u
 echo "== replaying $bag into rviz on $DISPLAY (master port $port)"
 roslaunch -p "$port" elo_odometry elo_bag.launch bag:="$bag" trajectory_file:="$work/poses.txt" rviz:=true \
+  rviz_config:="$rviz_config" \
   >"$work/roslaunch.log" 2>&1 &
 pids+=($!)
 
