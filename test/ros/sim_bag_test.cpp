@@ -95,7 +95,7 @@ void expectTheDrivesMap(ros::NodeHandle& node, LatestMessage<sensor_msgs::PointC
   EXPECT_NE(bytes.find("FIELDS x y z intensity normal_x normal_y normal_z\n"), std::string::npos);
   EXPECT_NE(bytes.find("DATA binary\n"), std::string::npos);
   const elo::MapCloud map = elo::readMapPcd(map_file);
-  ASSERT_GT(map.size(), 50000u);
+  ASSERT_GT(map.size(), 40000u) << "the 3 s drive's map holds about 50,000 points";
   // The road within 10 m of the start: its height in the file's frame.
   std::vector<float> road_heights;
   size_t normals = 0;
