@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <random>
 
@@ -160,19 +161,40 @@ TEST(PlaneFit, RecoversAPlaneAndItsFlatness) {
 }
 
 TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsARing) {
-  // z = 0.05 x - 0.02 y - 1.73: normal (-0.05, 0.02, 1), normalised.
+  // z = 0.05 x - 0.02 y - 1.73: normal (-0.05, 0.02, 1), normalised; points 10 cm apart across.
   std::vector<Float3> patch;
   for (int i = 0; i < 5; ++i) {
-    const float x = 10.0f + 0.07f * i;
-    const float y = 2.0f + 0.05f * ((i * 3) % 5);
+    const float x = 10.0f + 0.1f * i;
+    const float y = 2.0f + 0.1f * ((i * 3) % 5);
     patch.push_back({x, y, 0.05f * x - 0.02f * y - 1.73f});
   }
   const Float3 normal = groundPlaneNormal(patch.data(), 5, patch[0]);
   const Eigen::Vector3f expected = Eigen::Vector3f(-0.05f, 0.02f, 1.0f).normalized();
   EXPECT_GT(toVec3f(normal).dot(expected), 1.0f - 1e-6f);
+  std::vector<Float3> spot(5, Float3{10.0f, 2.0f, -1.73f});
+  EXPECT_TRUE(isZero(groundPlaneNormal(spot.data(), 5, spot[0])));
+}
+
+// The points of one ring give the road's slope along the ring, and a plane level across it: here a ring
+// along y on a road rising 3 % along y, its normal (0, -0.03, 1).
+TEST(GroundPlaneNormal, ARingGivesItsSlopeAlongAndLevelAcross) {
   std::vector<Float3> ring;
-  for (int i = 0; i < 5; ++i) ring.push_back({10.0f + 0.1f * i, 2.0f, -1.73f});  // one line in x-y
-  EXPECT_TRUE(isZero(groundPlaneNormal(ring.data(), 5, ring[0])));
+  for (int i = 0; i < 5; ++i) ring.push_back({10.0f, 2.0f + 0.05f * i, -1.73f + 0.03f * 0.05f * i});
+  const Float3 normal = groundPlaneNormal(ring.data(), 5, ring[0]);
+  EXPECT_GT(toVec3f(normal).dot(Eigen::Vector3f(0.0f, -0.03f, 1.0f).normalized()), 1.0f - 1e-6f);
+}
+
+// A ring ahead of the sensor on flat road, its points moved 2-3 cm along the beam (10 deg down) by range
+// noise: spread across the ring, but along the beam, so that a plane through them all leans towards the
+// sensor by some degrees. As one ring it stays level across: within 1 deg of the vertical (what is left
+// is the noise's share along the ring, of either sign).
+TEST(GroundPlaneNormal, ARingSpreadByRangeNoiseAlongTheBeamsDoesNotLean) {
+  const float along[] = {0.02f, -0.03f, 0.01f, 0.03f, -0.02f};
+  const float slope = std::tan(10.0f * static_cast<float>(M_PI) / 180.0f);
+  std::vector<Float3> ring;
+  for (int i = 0; i < 5; ++i) ring.push_back({10.0f + along[i], 2.0f + 0.05f * i, -1.73f - slope * along[i]});
+  const Float3 normal = groundPlaneNormal(ring.data(), 5, ring[0]);
+  EXPECT_GT(normal.z, std::cos(1.0f * static_cast<float>(M_PI) / 180.0f));
 }
 
 // A GroundMap of a small grid in which chosen cells hold a point numbered like the cell.

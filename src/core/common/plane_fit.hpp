@@ -187,13 +187,19 @@ ELO_HOST_DEVICE inline PlaneFit fitPlane(const PointMoments& moments) {
   return planeOf(symmetricEigen(moments.covariance()));
 }
 
-// Below this smallest eigenvalue of their horizontal spread (1 cm across the line) ground points lie on
-// one scan ring, and the plane through them could turn about it freely.
-constexpr float kMinCrossSpread = 1e-4f;
+// Below this smallest eigenvalue of their horizontal spread (5 cm across the line) ground points lie on
+// one scan ring, whose points tell the road's slope along the ring but not across it. The range noise
+// alone spreads a ring's points 2-3 cm across, along the beams, which slope down to the road: a plane
+// fitted to them leans towards the sensor, and the odometry took that lean for a pitch while the car was
+// slow and its ground model still one set of rings (VLP-16: 0.7 deg in the first 20 scans from rest,
+// then its height drifting 1 % of the distance; docs/accuracy.md). Two rings lie 10 cm or more apart.
+constexpr float kMinCrossSpread = 2.5e-3f;
+// Below this largest eigenvalue (1 cm along) the points are one spot: no plane.
+constexpr float kMinAlongSpread = 1e-4f;
 
-// The upward normal of the plane z = a x + b y + c fitted to `points` by least squares (a ground patch
-// is never vertical, so this 2x2 solve replaces an eigen-decomposition), or zero when the points are
-// (nearly) collinear in x-y.
+// The upward normal of the ground patch `points`: the plane z = a x + b y + c fitted by least squares (a
+// ground patch is never vertical, so this 2x2 solve replaces an eigen-decomposition); for the points of
+// one ring, the plane through the ring's slope along it, level across it; zero for (nearly) one spot.
 ELO_HOST_DEVICE inline Float3 groundPlaneNormal(const Float3* points, int count, const Float3& origin) {
   const Float3 none{0.0f, 0.0f, 0.0f};
   if (count < 3) return none;
@@ -203,11 +209,29 @@ ELO_HOST_DEVICE inline Float3 groundPlaneNormal(const Float3* points, int count,
   const float determinant = c.xx * c.yy - c.xy * c.xy;
   const float half_trace = 0.5f * (c.xx + c.yy);
   const float discriminant = half_trace * half_trace - determinant;
-  const float smallest_spread = half_trace - std::sqrt(discriminant > 0.0f ? discriminant : 0.0f);
-  if (!(smallest_spread >= kMinCrossSpread)) return none;
-  const float a = (c.yy * c.xz - c.xy * c.yz) / determinant;
-  const float b = (c.xx * c.yz - c.xy * c.xz) / determinant;
-  const Float3 normal{-a, -b, 1.0f};
+  const float root = std::sqrt(discriminant > 0.0f ? discriminant : 0.0f);
+  const float largest_spread = half_trace + root;
+  if (!(largest_spread >= kMinAlongSpread)) return none;
+  Float3 normal{0.0f, 0.0f, 1.0f};
+  if (half_trace - root >= kMinCrossSpread) {
+    normal.x = -(c.yy * c.xz - c.xy * c.yz) / determinant;
+    normal.y = -(c.xx * c.yz - c.xy * c.xz) / determinant;
+  } else {
+    // The ring's direction u, the eigenvector of the largest spread: of its two forms, the longer (the
+    // other may be all rounding), or an axis when the spread is the same every way.
+    float ux = largest_spread - c.yy;
+    float uy = c.xy;
+    if (c.xy * c.xy + (largest_spread - c.xx) * (largest_spread - c.xx) > ux * ux + uy * uy) {
+      ux = c.xy;
+      uy = largest_spread - c.xx;
+    }
+    const float length = std::sqrt(ux * ux + uy * uy);
+    ux = length > 0.0f ? ux / length : 1.0f;
+    uy = length > 0.0f ? uy / length : 0.0f;
+    const float slope = (ux * c.xz + uy * c.yz) / largest_spread;
+    normal.x = -slope * ux;
+    normal.y = -slope * uy;
+  }
   return normal / norm(normal);
 }
 
