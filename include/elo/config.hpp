@@ -169,8 +169,9 @@ struct MapConfig {
   double voxel_size = 0.2;
   // The moving-object filter: a non-ground voxel is written only when this many of the scans the map
   // took (scan_stride) saw it. A car driving at v m/s stays in a voxel for (its length / v) s, 4-5 scans
-  // at 10 m/s, 2-3 of them taken; a wall driven past is seen by tens of scans. Ground voxels are always written (the road does not move, and a sparse
-  // sensor's rings cross a ground voxel only once or twice). 1 writes every voxel.
+  // at 10 m/s, 2-3 of them taken; a wall driven past is seen by tens of scans. Ground voxels are always
+  // written (the road does not move, and a sparse sensor's rings cross a ground voxel only once or
+  // twice). 1 writes every voxel.
   int min_observations = 3;
   // The map takes every n-th registered scan. At 10 Hz consecutive scans see the same surfaces from
   // 0.1-3 m apart: every second one still sees each surface many times over, at half the map's CPU

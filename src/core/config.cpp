@@ -190,7 +190,7 @@ std::vector<Parameter> parameters(Config& c) {
                 "rounds of deskewing again under the motion estimated so far, one after each of the registration's first Gauss-Newton steps"),
       bindField("map.voxel_size", c.map.voxel_size, "edge of a voxel of the drive's map, m (docs/map.md)"),
       bindField("map.min_observations", c.map.min_observations,
-                "scans that must see a non-ground voxel of the drive's map for it to be written (moving objects)"),
+                "scans the drive's map took that must see a non-ground voxel for it to be written (moving objects)"),
       bindField("map.scan_stride", c.map.scan_stride,
                 "the drive's map takes every n-th registered scan; 1 = every scan (docs/map.md)"),
       bindChoice("runtime.backend", c.runtime.backend,

@@ -7,7 +7,10 @@
 namespace elo {
 
 MapBuilder::MapBuilder(const MapConfig& config, size_t max_queued, AfterScan after_scan)
-    : map_(config), selection_(config.scan_stride), max_queued_(std::max<size_t>(max_queued, 1)), after_scan_(std::move(after_scan)),
+    : map_(config),
+      selection_(config.scan_stride),
+      max_queued_(std::max<size_t>(max_queued, 1)),
+      after_scan_(std::move(after_scan)),
       thread_([this] { work(); }) {}
 
 MapBuilder::~MapBuilder() {
