@@ -29,11 +29,12 @@ struct Gate {
 };
 
 TEST(SimulatedAccuracy, UrbanDriveStaysWithinTwentyPercentOfTheMeasuredDrift) {
-  // Measured on 2026-11-22 on seed 11 (266 m): frame-to-model 0.0132 % and 0.0117 deg/100 m,
-  // frame-to-frame 0.417 % and 0.310 deg/100 m. Under the paper's literal closer-wins
-  // (model.same_surface_distance 0) they were 0.126 % and 0.069, 0.375 % and 0.271.
-  const std::vector<Gate> gates = {{RegistrationMode::frame_to_model, 0.0132, 0.0117},
-                                   {RegistrationMode::frame_to_frame, 0.417, 0.310}};
+  // Measured on 2026-11-26 on seed 11 (266 m), after the ground patches of one ring stopped leaning:
+  // frame-to-model 0.00344 % and 0.00271 deg/100 m, frame-to-frame 0.149 % and 0.175 deg/100 m (before:
+  // 0.0132 % and 0.0117, 0.417 % and 0.310). Under the paper's literal closer-wins
+  // (model.same_surface_distance 0) they were 0.126 % and 0.069, 0.375 % and 0.271 before both.
+  const std::vector<Gate> gates = {{RegistrationMode::frame_to_model, 0.00344, 0.00271},
+                                   {RegistrationMode::frame_to_frame, 0.149, 0.175}};
   std::vector<Config> configs(gates.size());
   for (size_t i = 0; i < gates.size(); ++i) configs[i].model.mode = gates[i].mode;
   const std::vector<TrajectoryEvaluation> evaluations = evaluateOnDrive(urbanCurves(11), configs);
@@ -50,9 +51,10 @@ TEST(SimulatedAccuracy, UrbanDriveStaysWithinTwentyPercentOfTheMeasuredDrift) {
 // The paper's Tables II and III on seed 1: the method (fused cost terms, range-adaptive normals) must
 // drift less than the SRI variants of Table II and than plain eigen normals and, in the paper's pipeline
 // (the scan/model normal gate opened from our 30 to 90 degrees), than the cross product. Measured
-// 2026-11-22: method 0.0123 %; SRI on all points 0.0374, SRI non-ground only 0.0229; plain eigen 0.0341;
-// gate opened: range-adaptive 0.0117, cross product 0.0927. With the gate at 30 degrees the cross product
-// drifts 0.0098 % here and is not gated (README, Accuracy).
+// 2026-11-26: method 0.0037 %; SRI on all points 0.0255, SRI non-ground only 0.0217; plain eigen 0.0317;
+// gate opened: range-adaptive 0.0048, cross product 0.0960 (2026-11-22, before the ground patches of one
+// ring stopped leaning: 0.0123; 0.0374, 0.0229; 0.0341; 0.0117, 0.0927). With the gate at 30 degrees the
+// cross product is not gated (docs/accuracy.md).
 TEST(SimulatedAccuracy, TheMethodWinsTablesTwoAndThree) {
   const std::vector<std::string> names = {"method", "SRI on all points", "SRI non-ground only",
                                           "plain eigen normals", "range-adaptive, gate opened",
