@@ -189,31 +189,6 @@ TEST(CloudConversion, AbsoluteTimestampsBecomeRelativeToTheStamp) {
   EXPECT_NEAR(converted.cloud.time[1], 0.025f, 1e-9f);
 }
 
-// rslidar_sdk (RoboSense) packs its XYZIRT point without padding: float32 intensity, uint16 ring and the
-// absolute float64 `timestamp` at byte 18, off its alignment, in a 26-byte point.
-TEST(CloudConversion, RoboSenseLayoutReadsItsUnalignedTimestampAndRing) {
-  const std::vector<FieldSpec> fields = {{"x", 0, PointField::FLOAT32},         {"y", 4, PointField::FLOAT32},
-                                         {"z", 8, PointField::FLOAT32},         {"intensity", 12, PointField::FLOAT32},
-                                         {"ring", 16, PointField::UINT16},      {"timestamp", 18, PointField::FLOAT64}};
-  sensor_msgs::PointCloud2 message = makeMessage(fields, 26, 2);
-  const double stamp = message.header.stamp.toSec();
-  for (uint32_t i = 0; i < 2; ++i) {
-    uint8_t* point = pointAt(message, 0, i);
-    put(point, 0, 4.0f + i);
-    put(point, 12, 10.0f * (i + 1));
-    put(point, 16, static_cast<uint16_t>(30 + i));
-    put(point, 18, stamp + 0.04 * i);  // 0 and 40 ms after the stamp
-  }
-  const elo_ros::ConvertedCloud converted = elo_ros::fromPointCloud2(message);
-  ASSERT_TRUE(converted.usable()) << converted.detail;
-  EXPECT_EQ(converted.cloud.points[1], elo::Vec3f(5, 0, 0));
-  EXPECT_EQ(converted.cloud.intensity, (std::vector<float>{10.0f, 20.0f}));
-  EXPECT_EQ(converted.cloud.ring, (std::vector<uint16_t>{30, 31}));
-  ASSERT_EQ(converted.cloud.time.size(), 2u);
-  EXPECT_NEAR(converted.cloud.time[0], 0.0f, 1e-9f);
-  EXPECT_NEAR(converted.cloud.time[1], 0.04f, 1e-6f);
-}
-
 // A time field whose type cannot hold a sweep's times loses the times, not the cloud, and says why.
 TEST(CloudConversion, ATimeFieldOfTheWrongTypeIsLeftOutWithTheReason) {
   const std::pair<const char*, uint8_t> wrong[] = {
