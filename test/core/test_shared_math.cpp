@@ -160,7 +160,7 @@ TEST(PlaneFit, RecoversAPlaneAndItsFlatness) {
   EXPECT_FALSE(fitPlane(two).valid);
 }
 
-TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsARing) {
+TEST(GroundPlaneNormal, FitsATiltedPatchAndRejectsASpot) {
   // z = 0.05 x - 0.02 y - 1.73: normal (-0.05, 0.02, 1), normalised; points 10 cm apart across.
   std::vector<Float3> patch;
   for (int i = 0; i < 5; ++i) {
