@@ -2,7 +2,9 @@
 // LiDAR on a car does, with exact ground truth and no moving cars. With deskew, frame-to-model drift stays
 // within 1.5 times the same drive's drift with instantaneous scans, for both time sources: the cloud's
 // per-point times (`field`, pose at the stamp, the sweep's start) and times from the azimuth (`azimuth`,
-// KITTI's convention, pose at mid-sweep). Frame-to-frame drift with deskew is lower than without.
+// KITTI's convention, pose at mid-sweep). Frame-to-frame drift in the plane (horizontal t_rel), where the
+// sweep's distortion acts, is lower with deskew than without: the VLP-16's frame-to-frame t_rel is height
+// from a ground model of one scan's rings, 5.5 % with deskew and without.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -100,9 +102,10 @@ DistortedRuns evaluateDistorted(const sim::SimulationSpec& field_spec, const std
 }
 
 void print(const std::string& drive, const std::string& run, const TrajectoryEvaluation& evaluation) {
-  std::cout << drive << ", " << run << ": t_rel " << evaluation.drift.t_rel_percent << " %, r_rel "
-            << evaluation.drift.r_rel_deg_per_100m << " deg/100m over " << evaluation.length_m << " m ("
-            << evaluation.drift.segments << " segments)" << std::endl;
+  std::cout << drive << ", " << run << ": t_rel " << evaluation.drift.t_rel_percent << " % (horizontal "
+            << evaluation.drift.t_rel_horizontal_percent << " %), r_rel " << evaluation.drift.r_rel_deg_per_100m
+            << " deg/100m over " << evaluation.length_m << " m (" << evaluation.drift.segments << " segments)"
+            << std::endl;
 }
 
 class DeskewAccuracy : public testing::TestWithParam<DistortedDrive> {};
@@ -136,8 +139,10 @@ TEST_P(DeskewAccuracy, DeskewedDriftStaysNearTheInstantaneousDrift) {
   const double bound = 1.5 * instantaneous.drift.t_rel_percent;
   EXPECT_LE(distorted.field[0].drift.t_rel_percent, bound) << "field times, f2m";
   EXPECT_LE(distorted.azimuth[0].drift.t_rel_percent, bound) << "azimuth times, f2m";
-  EXPECT_LT(distorted.field[1].drift.t_rel_percent, distorted.field[2].drift.t_rel_percent) << "field times, f2f";
-  EXPECT_LT(distorted.azimuth[1].drift.t_rel_percent, distorted.azimuth[2].drift.t_rel_percent) << "azimuth times, f2f";
+  EXPECT_LT(distorted.field[1].drift.t_rel_horizontal_percent, distorted.field[2].drift.t_rel_horizontal_percent)
+      << "field times, f2f";
+  EXPECT_LT(distorted.azimuth[1].drift.t_rel_horizontal_percent, distorted.azimuth[2].drift.t_rel_horizontal_percent)
+      << "azimuth times, f2f";
   std::cout << name << ": " << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s" << std::endl;
 }

@@ -100,10 +100,10 @@ void expectVlp16Targets(const SparseDrive& vlp16) {
 // 200 VLP-16 scans (166 m, turning 45 degrees) and their mirror image. Until the model update's equal-age
 // offers fell to the lower column, both drifted clockwise: -0.00100 and -0.00121 deg/scan (pair mean
 // -0.0011). Measured now (with the fading prior of degeneracy.hpp, the ground patches of one ring level
-// across it, plane_fit.hpp, and config/vlp16.yaml's nonground_weight 0.5): -0.000067 and +0.000102
-// (pair mean +0.000017), horizontal t_rel 0.020 and 0.024 %, largest slip over 10 scans 0.034 deg, t_rel
-// 0.047 and 0.051 % (0.24 % while the ground patches leaned), r_rel 0.048 and 0.051 deg/100 m; the
-// issue's targets are 0.2 % and 0.2 deg/100 m.
+// across it, plane_fit.hpp, and config/vlp16.yaml's outlier distance and weight): -0.000049 and
+// +0.000060 (pair mean +0.000005), horizontal t_rel 0.020 and 0.021 %, largest slip over 10 scans 0.009
+// deg, t_rel 0.047 and 0.049 % (0.24 % while the ground patches leaned), r_rel 0.035 and 0.036 deg/100 m;
+// the targets are 0.2 % and 0.2 deg/100 m.
 TEST(SparseSensors, HeadingDriftHasNoSignTurningLeftOrRight) {
   const SparseDrive left = drive("vlp16", urbanCurves(200, 3));
   const SparseDrive right = drive("vlp16", urbanCurves(200, 3, true));
@@ -118,8 +118,8 @@ TEST(SparseSensors, HeadingDriftHasNoSignTurningLeftOrRight) {
 
 // Thin stretches, where the scan holds little but the road: a country road between fields with a few
 // poles, trees and hedges (250 m), and a car park's open lot (141 m). The targets: the VLP-16's
-// above, the OS1-64 at horizontal t_rel 0.03 %. Measured: VLP-16 country 0.098 % / 0.083 % / 0.073,
-// parking 0.093 % / 0.046 % / 0.081; OS1-64 country horizontal 0.012 % (t_rel 0.015 %).
+// above, the OS1-64 at horizontal t_rel 0.03 %. Measured: VLP-16 country 0.060 % / 0.046 % / 0.030,
+// parking 0.094 % / 0.025 % / 0.098; OS1-64 country horizontal 0.012 % (t_rel 0.015 %).
 TEST(SparseSensors, ThinStretchesHoldTheTargets) {
   expectVlp16Targets(drive("vlp16", curvesIn(sim::WorldFamily::country, 200, 3)));
   expectVlp16Targets(drive("vlp16", curvesIn(sim::WorldFamily::parking, 300, 3)));
@@ -129,8 +129,8 @@ TEST(SparseSensors, ThinStretchesHoldTheTargets) {
 
 // The VLP-16 around the urban roundabout, `make accuracy`'s drive (seed 7, 1050 scans, 790 m from rest:
 // four times through a roundabout of 2 deg a scan, straights between). The targets. Measured:
-// t_rel 0.159 %, horizontal 0.154 %, r_rel 0.074 deg/100 m, largest slip over 10 scans 0.31 deg (0.212 %
-// with w1 0.7). The same drive from seeds 3 and 11 misses them (0.38 and 0.24 %, docs/accuracy.md).
+// t_rel 0.036 %, horizontal 0.023 %, r_rel 0.026 deg/100 m, largest slip over 10 scans 0.026 deg (0.212 %
+// and 0.31 deg before config/vlp16.yaml's outlier distance and weight). Seeds 3 and 11: 0.041 and 0.044 %.
 TEST(SparseSensors, Vlp16RoundaboutHoldsTheTargets) {
   const SparseDrive vlp16 = drive("vlp16", driveIn(sim::WorldFamily::urban, sim::TrajectoryKind::roundabout, 1050, 7));
   EXPECT_GT(vlp16.evaluation.length_m, 780.0);

@@ -85,10 +85,10 @@ TEST(SimulatedDistortedBag, NodeletDeskewsByTheCloudsTimes) {
             << largestPositionError(truth, nodelet) << " m, " << finalRotationErrorDeg(truth, nodelet)
             << " deg; not deskewed " << largestPositionError(truth, skewed) << " m, "
             << finalRotationErrorDeg(truth, skewed) << " deg" << std::endl;
-  // 1.5 times what the same drive (seed 3) gives as instantaneous scans: 0.192 m and 0.130 deg (elo_run
-  // with config/vlp16.yaml). Measured with deskew 0.185 m and 0.137 deg, without 2.11 m and 2.15 deg.
-  constexpr double kPositionBound = 0.29;  // m
-  constexpr double kRotationBoundDeg = 0.20;
+  // 1.5 times what the same drive (seed 3) gives as instantaneous scans: 0.202 m and 0.125 deg (elo_run
+  // with config/vlp16.yaml). Measured with deskew 0.202 m and 0.134 deg, without 0.99 m and 0.74 deg.
+  constexpr double kPositionBound = 0.30;  // m
+  constexpr double kRotationBoundDeg = 0.19;
   EXPECT_LT(largestPositionError(truth, nodelet), kPositionBound);
   EXPECT_LT(finalRotationErrorDeg(truth, nodelet), kRotationBoundDeg);
   // The bounds tell deskew from none: the same drive without it fails them.
