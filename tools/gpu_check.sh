@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The CUDA backend's check, in one table: the CPU/CUDA agreement tests, compute-sanitizer's memcheck and
-# racecheck over a few real scans (deskew on, so that every kernel runs), elo_run's poses with and without
-# the overlapped upload, and the CPU-against-GPU bench, frame-to-model, over simulated drives of three
-# sensors and the real scans.
+# racecheck over a few real scans (deskew on, so that every kernel runs) and over localization's map
+# rendering, elo_run's poses with and without the overlapped upload, localization on both backends, and
+# the CPU-against-GPU bench, frame-to-model, over simulated drives of three sensors and the real scans.
 #
 # On a GPU machine with a full build:   tools/gpu_check.sh build/devel/lib/elo_odometry [SCANS_DIR]
 # From a kit packed by gpu_kit.sh:      bash .gpukit/setup.sh && source .gpukit/env.sh && tools/gpu_check.sh
@@ -41,16 +41,17 @@ check_agreement() {
   fi
 }
 
-# compute-sanitizer TOOL over the first few real scans through the CUDA backend, deskew by azimuth on.
+# compute-sanitizer TOOL over elo_run through the CUDA backend on 5 scans of INPUT, with more options.
 check_sanitizer() {
-  local tool=$1 summary=$2 log=$work/$1.log
+  local tool=$1 summary=$2 what=$3 input=$4 log=$work/$1.log
+  shift 4
   if ! command -v compute-sanitizer >/dev/null; then fail "compute-sanitizer $tool" "not installed"; return; fi
-  compute-sanitizer --tool "$tool" --error-exitcode 3 "$bin/elo_run" --input "$scans" --output "$work/p.txt" \
-    --frames 5 --quiet --backend cuda --set deskew.time_source=azimuth >"$log" 2>&1
+  compute-sanitizer --tool "$tool" --error-exitcode 3 "$bin/elo_run" --input "$input" --output "$work/p.txt" \
+    --frames 5 --quiet --backend cuda "$@" >"$log" 2>&1
   local status=$? found
   found=$(grep -m1 "$summary" "$log" | sed 's/^========= //')
-  if [ "$status" -ne 0 ]; then fail "compute-sanitizer $tool, 5 real scans" "status $status; ${found:-no summary}"
-  else row "compute-sanitizer $tool, 5 real scans" "${found:-no summary printed}"; fi
+  if [ "$status" -ne 0 ]; then fail "compute-sanitizer $tool, $what" "status $status; ${found:-no summary}"
+  else row "compute-sanitizer $tool, $what" "${found:-no summary printed}"; fi
 }
 
 # Points per scan of a sequence: its .bin scans hold 16 bytes a point.
@@ -93,6 +94,34 @@ check_prefetch() {
     <<<"$with") ms a scan, $(awk '/^scan upload to GPU/ {print $5}' <<<"$without") ms with --no-prefetch"
 }
 
+# Localization (docs/localization.md) on each backend: a map of the drive (elo_run --map), the drive
+# localized in it from the map's origin. The row gives by how much the two backends' poses differ and
+# each one's FPS, odometry and map match together.
+check_localization() {
+  local name=$1 input=$2 map=$work/map.pcd cpu cuda difference
+  "$bin/elo_run" --input "$input" --output "$work/p.txt" --quiet --map "$map" >"$work/map.log" 2>&1 ||
+    { fail "localization, $name" "elo_run --map failed: $(tail -1 "$work/map.log")"; return; }
+  cpu=$("$bin/elo_run" --input "$input" --output "$work/localized_cpu.txt" --quiet --localize "$map" \
+    --backend cpu 2>&1) || { fail "localization, $name" "CPU: $(tail -1 <<<"$cpu")"; return; }
+  cuda=$("$bin/elo_run" --input "$input" --output "$work/localized_cuda.txt" --quiet --localize "$map" \
+    --backend cuda 2>&1) || { fail "localization, $name" "CUDA: $(tail -1 <<<"$cuda")"; return; }
+  echo "--- localization, $name, CUDA" >>"$work/bench.log"
+  echo "$cuda" >>"$work/bench.log"
+  # KITTI lines: the translation is entries 4, 8 and 12.
+  difference=$(paste -d' ' "$work/localized_cpu.txt" "$work/localized_cuda.txt" | awk '
+    { for (i = 4; i <= 12; i += 4) { d = $i - $(i + 12); if (d < 0) d = -d; if (d > worst) worst = d } }
+    END { printf "%.2g", worst + 0 }')
+  if awk -v d="$difference" 'BEGIN { exit !(d > 1e-3) }'; then
+    fail "localization, $name" "CPU and CUDA poses differ by up to $difference m"
+    return
+  fi
+  row "localization, $name" "CPU and CUDA poses within $difference m; FPS CPU $(fps_with_localization "$cpu"),\
+ CUDA $(fps_with_localization "$cuda")"
+  check_sanitizer memcheck "ERROR SUMMARY" "5 scans localized" "$input" --localize "$map"
+  check_sanitizer racecheck "RACECHECK SUMMARY" "5 scans localized" "$input" --localize "$map"
+}
+fps_with_localization() { sed -n 's/^FPS with localization: \([0-9.]*\).*/\1/p' <<<"$1"; }
+
 simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
   local sensor=$1 world=$2 trajectory=$3 dir=$4
   shift 4
@@ -103,9 +132,12 @@ simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
 gpu=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1)
 echo "GPU check: ${gpu:-no nvidia-smi}; $(nproc) CPU cores; nvcc $(nvcc --version 2>/dev/null | sed -n 's/.*release \([0-9.]*\).*/\1/p')"
 check_agreement
-check_sanitizer memcheck "ERROR SUMMARY"
-check_sanitizer racecheck "RACECHECK SUMMARY"
-check_sanitizer synccheck "ERROR SUMMARY"
+# The real scans deskewed by azimuth, so that every kernel of the odometry runs.
+for tool in memcheck racecheck synccheck; do
+  summary="ERROR SUMMARY"
+  [ $tool = racecheck ] && summary="RACECHECK SUMMARY"
+  check_sanitizer $tool "$summary" "5 real scans" "$scans" --set deskew.time_source=azimuth
+done
 
 bench=()
 simulate hdl64 urban curves "$work/hdl64"
@@ -123,6 +155,7 @@ bench_row "OS1-128, urban, $frames scans" "$work/os1_128" "$(mean_points "$work/
   --config "$configs/os1-128.yaml"
 [ -d "$scans" ] && bench_row "real HDL-64E, $(ls "$scans" | wc -l) scans" "$scans" "-"
 check_prefetch "HDL-64E, urban, $frames scans" "$work/hdl64"
+check_localization "HDL-64E, urban, $frames scans" "$work/hdl64"
 
 echo
 printf '%-44s %s\n' "check" "result"

@@ -100,19 +100,17 @@ class Backend {
 
   // Localization on a saved map (localization/localizer.hpp): a second model, rendered from map points
   // instead of fused from scans, that the current scan's features register against with the same cost.
-  // A backend that cannot (rendersMaps() false) throws std::runtime_error saying so from the others.
-  virtual bool rendersMaps() const { return false; }
   // Hands over the map (kept until the next call); `map` must have normals (prepareMap()).
-  virtual void setMap(std::shared_ptr<const MapCloud> map);
+  virtual void setMap(std::shared_ptr<const MapCloud> map) = 0;
   // Renders map points `points` (indices into the map) seen from the sensor at `map_from_sensor` into
   // the map model: the non-ground range image (points with a normal, each covering a disc of
   // localization.splat_radius) and the ground BEV (points whose height lies in the ground segmentation's
   // band), in the sensor's frame, as the model of a scan taken there would hold them.
-  virtual void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor);
+  virtual void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) = 0;
   // linearize() against the rendered map model: `rendered_from_scan` moves the scan's features into the
   // frame the map was rendered in.
-  virtual NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale);
-  virtual const Model& mapModel();
+  virtual NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) = 0;
+  virtual const Model& mapModel() = 0;
 };
 
 // Makes the backend `config.runtime.backend` names. When that is the CUDA backend and it cannot run here

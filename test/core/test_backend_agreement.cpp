@@ -1,14 +1,17 @@
 // The CUDA backend against the CPU backend on the same inputs, stage by stage: range images, point
-// indices, ground labels and BEV maps identical; normals within 1e-4; Gauss-Newton sums within 1e-6
-// (relative), and the GPU's the same bit for bit when linearised again; poses within 1e-4 m and 1e-4
-// rad at every frame. These tests skip, saying why, where no CUDA device is usable or the build has no
+// indices, ground labels and BEV maps identical (the scan's, the model's and a saved map's rendering);
+// normals within 1e-4; Gauss-Newton sums within 1e-6 (relative), and the GPU's the same bit for bit when
+// linearised again; poses within 1e-4 m and 1e-4 rad at every frame. These tests skip, saying why, where no CUDA device is usable or the build has no
 // CUDA backend. The factory tests run everywhere.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <numeric>
 
 #include "analytic_scene.hpp"
 #include "elo/io/sequence.hpp"
+#include "elo/localization/localizer.hpp"
+#include "elo/localization/point_map.hpp"
 #include "elo/odometry.hpp"
 
 namespace elo {
@@ -142,6 +145,20 @@ void expectIdenticalSums(const TermSums& first, const TermSums& again) {
   EXPECT_EQ(first.squared_error, again.squared_error);
 }
 
+// One linearisation on both backends (`linearize` of each, against its model or its map): sums that
+// agree, and the GPU's the same bit for bit when linearised again. Returns the CPU's.
+template <typename Linearize>
+NormalEquations expectAgreeingLinearizations(Backends& backends, const Linearize& linearize) {
+  const NormalEquations cpu = linearize(*backends.cpu);
+  const NormalEquations cuda = linearize(*backends.cuda);
+  expectAgreeingSums(cpu.nonground, cuda.nonground);
+  expectAgreeingSums(cpu.ground, cuda.ground);
+  const NormalEquations again = linearize(*backends.cuda);
+  expectIdenticalSums(cuda.nonground, again.nonground);
+  expectIdenticalSums(cuda.ground, again.ground);
+  return cpu;
+}
+
 void expectAgreeingPoses(const Eigen::Isometry3d& cpu, const Eigen::Isometry3d& cuda, size_t frame) {
   EXPECT_LT((cpu.translation() - cuda.translation()).norm(), kPoseTolerance) << "frame " << frame;
   EXPECT_LT(rotationAngle(cpu.inverse() * cuda), kPoseTolerance) << "frame " << frame;
@@ -273,13 +290,8 @@ TEST(BackendAgreement, GaussNewtonSumsAgreeForEveryCostVariant) {
     backends.prepare(streetScan(config, truth, 0.1, 0.02), 0.1f);
     for (const Eigen::Isometry3d& guess : {Eigen::Isometry3d::Identity(), truth, pose(0.5, 0.1, 0.0, 0.0, 0.0, 1.0)}) {
       for (const double kernel_scale : {0.0, 0.1, 0.4}) {
-        const NormalEquations cpu = backends.cpu->linearize(guess, kernel_scale);
-        const NormalEquations cuda = backends.cuda->linearize(guess, kernel_scale);
-        expectAgreeingSums(cpu.nonground, cuda.nonground);
-        expectAgreeingSums(cpu.ground, cuda.ground);
-        const NormalEquations again = backends.cuda->linearize(guess, kernel_scale);
-        expectIdenticalSums(cuda.nonground, again.nonground);
-        expectIdenticalSums(cuda.ground, again.ground);
+        expectAgreeingLinearizations(
+            backends, [&](Backend& backend) { return backend.linearize(guess, kernel_scale); });
       }
     }
   }
@@ -399,6 +411,111 @@ TEST(BackendAgreement, GpuRunsAreReproducible) {
     EXPECT_EQ(first.process(cloud).pose.matrix(), second.process(cloud).pose.matrix()) << "frame " << frame;
     truth = truth * pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
   }
+}
+
+// A saved map of the street: two scans' points placed at their poses, normals estimated at load.
+std::shared_ptr<MapCloud> streetMap(const Config& config) {
+  auto map = std::make_shared<MapCloud>();
+  for (const Eigen::Isometry3d& at : {pose(-20, 0, 0, 0, 0, 0), pose(-5, 0.5, 0, 0, 0, 4)}) {
+    for (const Vec3f& point : streetScan(config, at, 0.0, 0.02).points) {
+      map->points.push_back((at * point.cast<double>()).cast<float>());
+    }
+  }
+  prepareMap(*map, config.localization.normal_radius);
+  return map;
+}
+
+std::vector<int32_t> everyNth(size_t count, size_t step) {
+  std::vector<int32_t> points;
+  for (size_t i = 0; i < count; i += step) points.push_back(static_cast<int32_t>(i));
+  return points;
+}
+
+// The map rendered from the same pose on both backends: the same pixels, vertices and ranges, and the
+// same ground map in the same order; with and without the discs, from all points or a list of some, and
+// from none.
+TEST(BackendAgreement, MapRenderingsAreIdentical) {
+  ELO_REQUIRE_CUDA();
+  for (const double splat_radius : {0.0, Config().localization.splat_radius}) {
+    Config config;
+    config.localization.splat_radius = splat_radius;
+    const std::shared_ptr<MapCloud> map = streetMap(config);
+    Backends backends(config);
+    backends.cpu->setMap(map);
+    backends.cuda->setMap(map);
+    for (const size_t step : {1, 3}) {
+      for (const Eigen::Isometry3d& at : {pose(-12, 0.3, 0, 0, 0, 2), pose(-8, -0.5, 0.1, 1, -1, 12)}) {
+        SCOPED_TRACE("splat " + std::to_string(splat_radius) + ", every " + std::to_string(step) + " point");
+        const std::vector<int32_t> points = everyNth(map->size(), step);
+        backends.cpu->renderMap(points, at);
+        backends.cuda->renderMap(points, at);
+        const Model& cpu = backends.cpu->mapModel();
+        const Model& cuda = backends.cuda->mapModel();
+        EXPECT_GT(cpu.ground.size(), 1000u);
+        expectSameGroundMap(cpu.ground, cuda.ground);
+        expectAgreeingModelImage(cpu.nonground, cuda.nonground);
+      }
+    }
+    backends.cpu->renderMap({}, pose(-12, 0, 0, 0, 0, 0));
+    backends.cuda->renderMap({}, pose(-12, 0, 0, 0, 0, 0));
+    const Model& cuda = backends.cuda->mapModel();
+    EXPECT_EQ(cuda.ground.size(), 0u);
+    const std::vector<float>& ranges = cuda.nonground.range;
+    EXPECT_EQ(std::count_if(ranges.begin(), ranges.end(), [](float range) { return range > 0.0f; }), 0);
+  }
+}
+
+// A scan registered against the rendered map: the same sums on both backends, and on the GPU the same
+// bit for bit again.
+TEST(BackendAgreement, MapMatchSumsAgree) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  const std::shared_ptr<MapCloud> map = streetMap(config);
+  Backends backends(config);
+  const Eigen::Isometry3d truth = pose(-11, 0.4, 0.02, 0.3, -0.2, 3);
+  const Eigen::Isometry3d rendered_at = truth * pose(0.5, -0.2, 0.0, 0.0, 0.0, -1.5);
+  backends.prepare(streetScan(config, truth, 0.0, 0.02), 0.0f);
+  std::vector<int32_t> all(map->size());
+  std::iota(all.begin(), all.end(), 0);
+  for (Backend* backend : {backends.cpu.get(), backends.cuda.get()}) {
+    backend->setMap(map);
+    backend->renderMap(all, rendered_at);
+  }
+  for (const Eigen::Isometry3d& guess : {Eigen::Isometry3d::Identity(), rendered_at.inverse() * truth}) {
+    for (const double kernel_scale : {0.0, 0.2}) {
+      const NormalEquations cpu = expectAgreeingLinearizations(
+          backends, [&](Backend& backend) { return backend.linearizeMap(guess, kernel_scale); });
+      EXPECT_GT(cpu.nonground.inliers, 1000);
+      EXPECT_GT(cpu.ground.inliers, 1000);
+    }
+  }
+}
+
+// Localization down the street on both backends, from a hint 1.5 m and 6 degrees off: the same states,
+// and poses within the odometry's tolerance at every scan.
+TEST(BackendAgreement, LocalizedPosesAgree) {
+  ELO_REQUIRE_CUDA();
+  const std::shared_ptr<MapCloud> map = streetMap(Config());
+  OdometryOnBothBackends odometry(RegistrationMode::frame_to_model);
+  Localizer cpu(odometry.cpu, map);
+  Localizer cuda(odometry.cuda, map);
+  Eigen::Isometry3d truth = pose(-18, 0, 0, 0, 0, 0);
+  const Eigen::Isometry3d hint = truth * pose(1.2, 0.9, 0.0, 0.0, 0.0, 6.0);
+  cpu.setInitialPose(hint);
+  cuda.setInitialPose(hint);
+  LocalizationState state = LocalizationState::waiting_for_pose;
+  for (int frame = 0; frame < 12; ++frame) {
+    const PointCloud cloud = streetScan(Config(), truth, 0.1 * frame, 0.02);
+    const LocalizationResult a = cpu.update(odometry.cpu.process(cloud));
+    const LocalizationResult b = cuda.update(odometry.cuda.process(cloud));
+    state = a.state;
+    ASSERT_EQ(a.state, b.state) << "frame " << frame;
+    EXPECT_EQ(a.matched, b.matched) << "frame " << frame;
+    EXPECT_EQ(a.map_points_rendered, b.map_points_rendered) << "frame " << frame;
+    expectAgreeingPoses(a.pose, b.pose, static_cast<size_t>(frame));
+    truth = truth * pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.6);
+  }
+  EXPECT_EQ(state, LocalizationState::tracking);
 }
 
 // Sweeps down the street at 10 m/s while turning: points with rings and per-point times.

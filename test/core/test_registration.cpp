@@ -105,6 +105,10 @@ class ShrinkingSteps : public Backend {
   const ScanImage& scan() override { return scan_; }
   const BevImage& scanGround() override { return ground_; }
   const Model& model() override { return model_; }
+  void setMap(std::shared_ptr<const MapCloud>) override {}
+  void renderMap(const std::vector<int32_t>&, const Eigen::Isometry3d&) override {}
+  NormalEquations linearizeMap(const Eigen::Isometry3d&, double) override { return {}; }
+  const Model& mapModel() override { return model_; }
 
  private:
   double ratio_;

@@ -2,7 +2,8 @@
 // most of it, so the stage tests cover it too; these tests cover what is new or only the CUDA backend
 // runs: the ported eigen-solver, the keys, transforms and point-to-plane terms, windowNormal(), the
 // scalar normal estimator of the GPU, against the CPU backend's vectorised one, the GPU's tiles of the scan
-// it reads its windows from, and the GPU's per-pixel ground labels against the CPU's column walk.
+// it reads its windows from, the GPU's per-pixel ground labels against the CPU's column walk, and the
+// rules of localization's map rendering.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <set>
 
 #include "analytic_scene.hpp"
 #include "core/common/association.hpp"
@@ -17,6 +19,7 @@
 #include "core/common/model_update.hpp"
 #include "core/common/eigen_interop.hpp"
 #include "core/common/ground.hpp"
+#include "core/common/map_render.hpp"
 #include "core/common/normals.hpp"
 #include "core/common/point_to_plane.hpp"
 #include "core/cpu/eigen_lanes.hpp"
@@ -512,6 +515,49 @@ TEST(ColumnBits, PerPixelGroundLabelsAreThoseOfTheColumnWalk) {
   }
   EXPECT_GT(ground, 1000u);
   EXPECT_GT(nonground, 1000u);
+}
+
+// The pixels forEachSplatPixel() offers a point at (row, col), `range` away, with a disc of 1 m.
+std::set<std::pair<int, int>> splatPixels(const SphericalProjection& projection, int row, int col, float range) {
+  std::set<std::pair<int, int>> pixels;
+  forEachSplatPixel(projection, row, col, range, 1.0f,
+                    [&](int pixel) { pixels.insert({pixel / projection.cols, pixel % projection.cols}); });
+  return pixels;
+}
+
+// A disc spans as many whole rows and columns either side as its angle covers: across the azimuth seam,
+// cut at the image's edge, at most 4 columns and 2 rows however close, and a far point its pixel alone.
+TEST(MapRenderRules, ADiscCoversItsPixelsAcrossTheSeamUpToTheCap) {
+  SphericalProjection projection;
+  projection.rows = 10;
+  projection.cols = 100;      // 0.0628 rad a column
+  projection.fov_span = 0.5f;  // 0.05 rad a row
+  // 0.13 rad: 2 columns and 2 rows either side; at the top-left corner, rows 0-2 and columns 98-2.
+  std::set<std::pair<int, int>> expected;
+  for (int row = 0; row <= 2; ++row) {
+    for (const int col : {98, 99, 0, 1, 2}) expected.insert({row, col});
+  }
+  EXPECT_EQ(splatPixels(projection, 0, 0, 1.0f / 0.13f), expected);
+  // 2 rad, capped: 4 columns and 2 rows either side.
+  expected.clear();
+  for (int row = 3; row <= 7; ++row) {
+    for (int col = 46; col <= 54; ++col) expected.insert({row, col});
+  }
+  EXPECT_EQ(splatPixels(projection, 5, 50, 0.5f), expected);
+  EXPECT_EQ(splatPixels(projection, 9, 99, 100.0f), (std::set<std::pair<int, int>>{{9, 99}}));
+}
+
+// A map point is ground in the band when its normal is near vertical (either way) or unknown; the
+// height above the band's floor ranks a cell's ground points.
+TEST(MapRenderRules, GroundIsTheBandWhereNormalsAreNearVertical) {
+  const MapRendering rendering{0.2f, -2.0f, -1.5f, 0.3f};
+  const Float3 road{5.0f, 1.0f, -1.8f};
+  EXPECT_TRUE(isMapGround(road, Float3{0.0f, 0.0f, 0.0f}, rendering));
+  EXPECT_TRUE(isMapGround(road, Float3{0.0f, 0.3f, -0.95f}, rendering));
+  EXPECT_FALSE(isMapGround(road, Float3{0.6f, 0.0f, 0.8f}, rendering));  // a kerb's face
+  EXPECT_FALSE(isMapGround(Float3{5.0f, 1.0f, -1.4f}, Float3{0.0f, 0.0f, 1.0f}, rendering));
+  EXPECT_FALSE(isMapGround(Float3{5.0f, 1.0f, -2.1f}, Float3{0.0f, 0.0f, 1.0f}, rendering));
+  EXPECT_NEAR(mapGroundAge(road, rendering), 0.2f, 1e-6f);
 }
 
 }  // namespace

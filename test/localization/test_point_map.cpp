@@ -124,7 +124,6 @@ TEST_F(MapFile, SomeNormalFieldsButNotAllIsAnError) {
 // Pixels of the rendered range image that hold a point, all on the wall.
 size_t renderedWallPixels(const Config& config, const std::shared_ptr<MapCloud>& map, size_t floor_points) {
   std::unique_ptr<Backend> backend = makeBackend(config);
-  EXPECT_TRUE(backend->rendersMaps());
   backend->setMap(map);
   std::vector<int32_t> all(map->size());
   std::iota(all.begin(), all.end(), 0);
@@ -163,39 +162,6 @@ TEST(MapRendering, WallGoesToTheRangeImageAndFloorToTheBevMap) {
   std::printf("wall pixels filled: %zu of %zu splatted, %zu by the points alone\n", splatted, wall_pixels, points_alone);
   EXPECT_GE(splatted, wall_pixels * 3 / 4);
   EXPECT_LE(points_alone, wall_pixels / 10);
-}
-
-// A backend without map rendering refuses, saying which backend and what to use instead.
-class NoMapsBackend : public Backend {
- public:
-  const char* name() const override { return "cuda"; }
-  size_t projectScan(const PointCloud&, float, const SweepMotion&) override { return 0; }
-  void deskewScan(const Vector6d&) override {}
-  void segmentGround() override {}
-  void estimateNormals() override {}
-  void buildGroundMap() override {}
-  NormalEquations linearize(const Eigen::Isometry3d&, double) override { return {}; }
-  void updateModel(const Eigen::Isometry3d&, float) override {}
-  void resetModel() override {}
-  const ScanImage& scan() override { return scan_; }
-  const BevImage& scanGround() override { return ground_; }
-  const Model& model() override { return model_; }
-
- private:
-  ScanImage scan_;
-  BevImage ground_;
-  Model model_;
-};
-
-TEST(MapRendering, ABackendWithoutItRefusesClearly) {
-  NoMapsBackend backend;
-  EXPECT_FALSE(backend.rendersMaps());
-  try {
-    backend.renderMap({}, Eigen::Isometry3d::Identity());
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("cuda backend cannot localize"), std::string::npos) << error.what();
-  }
 }
 
 }  // namespace

@@ -63,8 +63,9 @@ struct LocalizationResult {
 
 class Localizer {
  public:
-  // Localizes `odometry`'s scans in `map` (prepared: with normals). Throws std::runtime_error when the
-  // odometry's backend cannot render maps, std::invalid_argument for an empty map.
+  // Localizes `odometry`'s scans in `map` (prepared: with normals). Throws std::invalid_argument for an
+  // empty map or one without normals, and std::runtime_error when the backend cannot hold the map (the
+  // CUDA backend: larger than the device's free memory).
   Localizer(Odometry& odometry, std::shared_ptr<const MapCloud> map);
 
   // The sensor's pose in the map near the next scan: that scan searches around it (localization.search_*

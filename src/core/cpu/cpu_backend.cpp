@@ -162,11 +162,7 @@ void CpuBackend::setMap(std::shared_ptr<const MapCloud> map) {
 
 void CpuBackend::renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) {
   if (!map_) throw std::logic_error("renderMap() before setMap()");
-  const GroundConfig& ground = config_.ground;
-  const MapRendering rendering{static_cast<float>(config_.localization.splat_radius),
-                               static_cast<float>(-ground.sensor_height - ground.band_below),
-                               static_cast<float>(-ground.sensor_height + ground.band_above),
-                               static_cast<float>(config_.model.same_surface_distance)};
+  const MapRendering rendering = MapRendering::fromConfig(config_);
   arena_.execute([&] {
     renderMapModel(*map_, points, toRigid3f(map_from_sensor.inverse()), spherical_, bev_, rendering, map_scratch_,
                    map_model_);

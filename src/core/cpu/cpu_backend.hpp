@@ -25,7 +25,6 @@ class CpuBackend final : public Backend {
   const BevImage& scanGround() override { return scan_ground_; }
   const Model& model() override { return model_; }
 
-  bool rendersMaps() const override { return true; }
   void setMap(std::shared_ptr<const MapCloud> map) override;
   void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) override;
   NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) override;

@@ -8,6 +8,7 @@
 
 #include "core/common/deskew.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/common/map_render.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
 #include "core/common/scan_projection.hpp"
@@ -181,14 +182,6 @@ struct MapRenderScratch {
   std::vector<Float3> vertex;
   std::vector<Float3> normal;
   GroundMapScratch ground;
-};
-// How a map point is drawn: the disc it covers (m), and the band of heights below the sensor where a
-// point is ground (the ground segmentation's, GroundConfig) when its normal is near vertical or unknown.
-struct MapRendering {
-  float splat_radius;
-  float ground_low;   // -sensor_height - band_below
-  float ground_high;  // -sensor_height + band_above
-  float same_surface_distance;
 };
 // Renders `points` of `map` (which has normals) moved by `sensor_from_map` into `model`: the non-ground
 // points with a normal into its range image, closest wins per pixel, each covering the pixels its disc

@@ -1,10 +1,13 @@
 #include "core/cuda/cuda_backend.hpp"
 
 #include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include "core/common/eigen_interop.hpp"
 #include "core/common/term_sums.hpp"
 #include "core/elapsed_time.hpp"
+#include "elo/map_cloud.hpp"
 #include "elo/sensor_model.hpp"
 
 namespace elo::cuda {
@@ -47,6 +50,26 @@ void CudaBackend::BevBuffers::allocate(size_t grid_cells, size_t points) {
   vertices.reserve(points);
   ranges.reserve(points);
   stamps.reserve(points);
+}
+
+void CudaBackend::FittedGroundNormals::clear(size_t points, cudaStream_t stream) {
+  cuda::clear(epochs, points, 0, stream);
+  epoch = 1;
+}
+
+void CudaBackend::FittedGroundNormals::startEpoch(size_t points, cudaStream_t stream) {
+  if (++epoch == 0) clear(points, stream);  // wrapped: 0 means "none fitted"
+}
+
+// Room for a render of `sources` map points (CellCompaction's per-source arrays among them).
+void CudaBackend::MapBuffers::reserveRender(size_t sources) {
+  staged_indices.reserve(sources);
+  indices.reserve(sources);
+  source_vertices.reserve(sources);
+  source_normals.reserve(sources);
+  source_cells.reserve(sources);
+  first_flags.reserve(sources);
+  tile_firsts.reserve(compactionTiles(sources));
 }
 
 CudaBackend::CudaBackend(const Config& config)
@@ -92,8 +115,10 @@ void CudaBackend::allocate() {
     model_image_[buffer].allocate(pixels_);
     model_ground_[buffer].allocate(cells_, cells_);  // one point per cell at most
   }
-  model_ground_normals_.reserve(cells_);
-  model_ground_normal_epochs_.reserve(cells_);
+  model_ground_normals_.allocate(cells_);
+  map_image_.allocate(pixels_);
+  map_ground_.allocate(cells_, cells_);
+  map_ground_normals_.allocate(cells_);
   // A fusion's sources are the model's points (at most one per cell) and the scan's (at most one per pixel).
   const size_t sources = cells_ + pixels_;
   cell_keys_.reserve(cells_);
@@ -114,7 +139,7 @@ void CudaBackend::allocate() {
 // Empty images and maps, and the compaction scratch at "none" (all bytes 0xff), as the kernels expect.
 void CudaBackend::clearDevice() {
   const cudaStream_t stream = stream_.get();
-  for (const SphericalBuffers* image : {&scan_image_, &model_image_[0], &model_image_[1]}) {
+  for (const SphericalBuffers* image : {&scan_image_, &model_image_[0], &model_image_[1], &map_image_}) {
     clear(image->vertices, pixels_, 0, stream);
     clear(image->normals, pixels_, 0, stream);
     clear(image->ranges, pixels_, 0, stream);
@@ -124,7 +149,7 @@ void CudaBackend::clearDevice() {
   clear(labels_, pixels_, 0, stream);
   clear(measured_, pixels_, 0, stream);
   clear(pixel_times_, pixels_, 0, stream);
-  for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1]}) {
+  for (const BevBuffers* map : {&scan_ground_, &model_ground_[0], &model_ground_[1], &map_ground_}) {
     clear(map->point_of_cell, cells_, 0xff, stream);
   }
   clear(closest_keys_, pixels_, 0xff, stream);
@@ -133,7 +158,8 @@ void CudaBackend::clearDevice() {
   clear(surface_keys_, cells_, 0xff, stream);
   clear(first_sources_, cells_, 0xff, stream);
   clear(counts_, kCounts, 0, stream);
-  clear(model_ground_normal_epochs_, cells_, 0, stream);  // epoch 0: no normal fitted
+  model_ground_normals_.clear(cells_, stream);
+  map_ground_normals_.clear(cells_, stream);
   // linearize()'s count of the blocks done at 0, and its partial sums initialised: its last block reads
   // (and drops) the rows of a term not summed.
   clear(finished_blocks_, 1, 0, stream);
@@ -156,8 +182,7 @@ DeviceScan CudaBackend::deviceScan() const {
           measured_.data(),          pixel_times_.data()};
 }
 
-DeviceModelImage CudaBackend::deviceModel(int buffer) const {
-  const SphericalBuffers& image = model_image_[buffer];
+DeviceModelImage CudaBackend::deviceImage(const SphericalBuffers& image) const {
   return {spherical_.rows, spherical_.cols, image.vertices.data(), image.normals.data(), image.ranges.data(),
           image.stamps.data()};
 }
@@ -170,6 +195,12 @@ DeviceBev CudaBackend::deviceBev(const BevBuffers& buffers, int count) const {
 CellCompaction CudaBackend::compaction() const {
   return {cell_keys_.data(),    surface_keys_.data(), first_sources_.data(),
           source_cells_.data(), first_flags_.data(),  tile_firsts_.data()};
+}
+
+// The per-cell arrays are "none" again after every compaction, so the map's render shares them.
+CellCompaction CudaBackend::mapCompaction() const {
+  return {cell_keys_.data(),          surface_keys_.data(),     first_sources_.data(),
+          map_.source_cells.data(), map_.first_flags.data(), map_.tile_firsts.data()};
 }
 
 void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
@@ -307,6 +338,13 @@ void CudaBackend::buildGroundMap() {
 }
 
 NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
+  return linearizeAgainst(deviceModel(current_), modelGroundMap(current_), model_ground_normals_.cache(),
+                          model_from_scan, kernel_scale);
+}
+
+NormalEquations CudaBackend::linearizeAgainst(const DeviceModelImage& model, const DeviceBev& model_ground,
+                                              const GroundNormalCache& ground_normals,
+                                              const Eigen::Isometry3d& model_from_scan, double kernel_scale) {
   const CostTerms terms = config_.registration.terms;
   LinearizeInputs inputs{};
   inputs.nonground = terms != CostTerms::bev_ground;
@@ -314,12 +352,12 @@ NormalEquations CudaBackend::linearize(const Eigen::Isometry3d& model_from_scan,
   inputs.scan = deviceScan();
   inputs.registration_pixels = registration_pixels_.data();
   inputs.registration_count = counts_.data() + kRegistrationPixels;
-  inputs.model = deviceModel(current_);
+  inputs.model = model;
   inputs.spherical = spherical_;
   inputs.scan_ground = scanGroundMap();
-  inputs.model_ground = modelGroundMap(current_);
+  inputs.model_ground = model_ground;
   inputs.bev = bev_;
-  inputs.ground_normals = {model_ground_normals_.data(), model_ground_normal_epochs_.data(), model_epoch_};
+  inputs.ground_normals = ground_normals;
   inputs.normal_neighbours = config_.bev.normal_neighbours;
   inputs.patch_radius = config_.bev.normal_patch_radius;
   inputs.gates = gates_;
@@ -350,16 +388,8 @@ void CudaBackend::updateModel(const Eigen::Isometry3d& model_from_scan, float st
     current_ = next;
   }
   model_initialized_ = true;
-  startModelEpoch();
+  model_ground_normals_.startEpoch(cells_, stream);
   model_view_current_ = false;
-}
-
-// The ground normals fitted for the previous model are stale from here on.
-void CudaBackend::startModelEpoch() {
-  if (++model_epoch_ == 0) {  // wrapped: 0 means "none fitted"
-    clear(model_ground_normal_epochs_, cells_, 0, stream_.get());
-    model_epoch_ = 1;
-  }
 }
 
 void CudaBackend::resetModel() {
@@ -367,7 +397,7 @@ void CudaBackend::resetModel() {
   clear(model_image_[current_].ranges, pixels_, 0, stream);
   clear(model_image_[current_].normals, pixels_, 0, stream);
   cuda::clearGroundMap(modelGroundMap(current_), stream);
-  startModelEpoch();
+  model_ground_normals_.startEpoch(cells_, stream);
   model_initialized_ = false;
   model_view_current_ = false;
 }
@@ -416,21 +446,107 @@ const BevImage& CudaBackend::scanGround() {
   return scan_ground_view_;
 }
 
+void CudaBackend::copyModelView(const SphericalBuffers& image, const BevBuffers& ground, int ground_points,
+                                Model& view) {
+  if (view.nonground.range.empty()) view.nonground.resize(spherical_.rows, spherical_.cols);
+  const cudaStream_t stream = stream_.get();
+  copyToHost(view.nonground.vertex, image.vertices.data(), pixels_, stream);
+  copyToHost(view.nonground.normal, image.normals.data(), pixels_, stream);
+  copyToHost(view.nonground.range, image.ranges.data(), pixels_, stream);
+  copyToHost(view.nonground.stamp, image.stamps.data(), pixels_, stream);
+  fetchCount(ground_points);
+  synchronize();  // the count, before the points are copied
+  copyBevView(ground, host_counts_[ground_points], view.ground);
+}
+
 const Model& CudaBackend::model() {
   if (model_view_current_) return model_view_;
-  if (model_view_.nonground.range.empty()) model_view_.nonground.resize(spherical_.rows, spherical_.cols);
-  const SphericalBuffers& image = model_image_[current_];
-  const cudaStream_t stream = stream_.get();
-  copyToHost(model_view_.nonground.vertex, image.vertices.data(), pixels_, stream);
-  copyToHost(model_view_.nonground.normal, image.normals.data(), pixels_, stream);
-  copyToHost(model_view_.nonground.range, image.ranges.data(), pixels_, stream);
-  copyToHost(model_view_.nonground.stamp, image.stamps.data(), pixels_, stream);
-  fetchCount(kModelPoints + current_);
-  synchronize();  // the count, before the points are copied
-  copyBevView(model_ground_[current_], host_counts_[kModelPoints + current_], model_view_.ground);
+  copyModelView(model_image_[current_], model_ground_[current_], kModelPoints + current_, model_view_);
   model_view_.initialized = model_initialized_;
   model_view_current_ = true;
   return model_view_;
+}
+
+void CudaBackend::setMap(std::shared_ptr<const MapCloud> map) {
+  if (map && !map->hasNormals() && map->size() > 0) {
+    throw std::invalid_argument("the map has no normals (prepareMap())");
+  }
+  synchronize();  // no kernel reads the map being replaced
+  map_set_ = map != nullptr;
+  if (map_set_ && map->size() > 0) uploadMap(*map);
+  clearMapModel();
+}
+
+// The map's points and normals, 24 bytes a point, copied once. A map that does not fit in the device's
+// free memory is refused, saying how much it needs.
+void CudaBackend::uploadMap(const MapCloud& map) {
+  const size_t count = map.size();
+  if (count > map_.capacity) {
+    size_t free_bytes = 0;
+    size_t total_bytes = 0;
+    check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
+    const size_t needed = count * 2 * sizeof(Float3);
+    const size_t held = map_.capacity * 2 * sizeof(Float3);  // freed before the new copy is allocated
+    if (needed > free_bytes + held) {
+      constexpr double kMiB = 1024.0 * 1024.0;
+      throw std::runtime_error("the map's " + std::to_string(count) + " points need " +
+                               std::to_string(static_cast<long>(needed / kMiB)) +
+                               " MiB on the GPU and " + std::to_string(static_cast<long>((free_bytes + held) / kMiB)) +
+                               " MiB are free: localize on the CPU backend, or thin the map (a coarser voxel)");
+    }
+    map_.points.reserve(count);
+    map_.normals.reserve(count);
+    map_.capacity = count;
+  }
+  check(cudaMemcpy(map_.points.data(), map.points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice),
+        "uploading the map's points");
+  check(cudaMemcpy(map_.normals.data(), map.normals.data(), count * sizeof(Float3), cudaMemcpyHostToDevice),
+        "uploading the map's normals");
+}
+
+// Before the first render, and after a new map: an empty model.
+void CudaBackend::clearMapModel() {
+  const cudaStream_t stream = stream_.get();
+  clear(map_image_.ranges, pixels_, 0, stream);
+  clear(map_image_.normals, pixels_, 0, stream);
+  cuda::clearGroundMap(mapGroundMap(), stream);
+  map_ground_normals_.startEpoch(cells_, stream);
+  map_rendered_ = false;
+  map_model_view_current_ = false;
+}
+
+void CudaBackend::renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) {
+  if (!map_set_) throw std::logic_error("renderMap() before setMap()");
+  const cudaStream_t stream = stream_.get();
+  synchronize();  // the last render's copy has read the staged indices
+  map_.reserveRender(points.size());
+  if (!points.empty()) {
+    std::memcpy(map_.staged_indices.data(), points.data(), points.size() * sizeof(int32_t));
+    check(cudaMemcpyAsync(map_.indices.data(), map_.staged_indices.data(), points.size() * sizeof(int32_t),
+                          cudaMemcpyHostToDevice, stream),
+          "uploading the map points to render");
+  }
+  const MapRenderSources sources{map_.indices.data(), static_cast<int>(points.size()), map_.source_vertices.data(),
+                                 map_.source_normals.data()};
+  cuda::renderMapModel({map_.points.data(), map_.normals.data()}, sources, toRigid3f(map_from_sensor.inverse()),
+                       spherical_, bev_, MapRendering::fromConfig(config_), closest_keys_.data(),
+                       deviceImage(map_image_), mapGroundMap(), mapCompaction(), stream);
+  map_ground_normals_.startEpoch(cells_, stream);
+  map_rendered_ = true;
+  map_model_view_current_ = false;
+}
+
+NormalEquations CudaBackend::linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) {
+  return linearizeAgainst(deviceImage(map_image_), mapGroundMap(), map_ground_normals_.cache(), rendered_from_scan,
+                          kernel_scale);
+}
+
+const Model& CudaBackend::mapModel() {
+  if (map_model_view_current_) return map_model_view_;
+  copyModelView(map_image_, map_ground_, kMapGroundPoints, map_model_view_);
+  map_model_view_.initialized = map_rendered_;
+  map_model_view_current_ = true;
+  return map_model_view_;
 }
 
 }  // namespace elo::cuda

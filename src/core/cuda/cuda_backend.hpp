@@ -1,11 +1,13 @@
 // The CUDA implementation of the backend interface: the stages of src/core/cuda/*.cu, queued on one
 // stream over device buffers that mirror include/elo/types.hpp and are allocated once, in the
-// constructor (only the cloud upload grows, when a scan has more points than any before). The scan
+// constructor (only the cloud upload grows, when a scan has more points than any before, and
+// localization's map and render buffers, with the map and the largest render). The scan
 // goes up through pinned memory, in one of two upload buffers: the next scan, when prefetched, is staged
 // into the other one on a thread of its own and copied on a stream of its own while this one is
 // processed. The host views are copied back when asked for, and only when the device buffers changed since.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "core/cuda/device_buffer.hpp"
@@ -34,6 +36,13 @@ class CudaBackend final : public Backend {
   const BevImage& scanGround() override;
   const Model& model() override;
 
+  // Localization (renderMap()): the map is uploaded once and stays on the device; a render uploads the
+  // indices of the points it draws.
+  void setMap(std::shared_ptr<const MapCloud> map) override;
+  void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) override;
+  NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) override;
+  const Model& mapModel() override;
+
   void synchronize() override;
   void prefetch(const PointCloud& cloud) override;
   void finishPrefetch() noexcept override;
@@ -57,9 +66,48 @@ class CudaBackend final : public Backend {
 
     void allocate(size_t grid_cells, size_t points);
   };
+  // The normals of a ground map's points fitted so far (GroundNormalCache), a slot per point; a new epoch
+  // for every change of the map makes them all stale at once.
+  struct FittedGroundNormals {
+    DeviceArray<Float3> normals;
+    DeviceArray<unsigned> epochs;
+    unsigned epoch = 1;
+
+    void allocate(size_t points) {
+      normals.reserve(points);
+      epochs.reserve(points);
+    }
+    void clear(size_t points, cudaStream_t stream);  // every epoch 0: none fitted
+    void startEpoch(size_t points, cudaStream_t stream);
+    GroundNormalCache cache() const { return {normals.data(), epochs.data(), epoch}; }
+  };
+  // Localization's map on the device (setMap()), and one render's sources: the indices of the points
+  // drawn, staged and on the device, their vertices and normals in the sensor's frame, and the cell
+  // compaction's per-source arrays. They grow with the largest render.
+  struct MapBuffers {
+    size_t capacity = 0;  // points the map's arrays hold
+    DeviceArray<Float3> points;
+    DeviceArray<Float3> normals;
+    PinnedArray<int32_t> staged_indices;
+    DeviceArray<int32_t> indices;
+    DeviceArray<Float3> source_vertices;
+    DeviceArray<Float3> source_normals;
+    DeviceArray<int> source_cells;
+    DeviceArray<int> first_flags;
+    DeviceArray<int> tile_firsts;
+
+    void reserveRender(size_t sources);
+  };
   // The counts the kernels write, at these indices of counts_ (and host_counts_, their pinned copy); the
   // point counts of the two model buffers are at kModelPoints and kModelPoints + 1.
-  enum Count { kOccupiedPixels, kRegistrationPixels, kScanGroundPoints, kModelPoints, kCounts = kModelPoints + 2 };
+  enum Count {
+    kOccupiedPixels,
+    kRegistrationPixels,
+    kScanGroundPoints,
+    kMapGroundPoints,
+    kModelPoints,
+    kCounts = kModelPoints + 2
+  };
 
   // A cloud's arrays as an upload reads them; `rings` and `times` are null when they do not go up.
   struct HostCloud {
@@ -92,7 +140,6 @@ class CudaBackend final : public Backend {
   };
 
   void allocate();
-  void startModelEpoch();
   void clearDevice();
   HostCloud hostCloud(const PointCloud& cloud, bool with_times) const;
   // Uploads the points, their rings when the projection uses them and their times when `with_times`, or
@@ -100,14 +147,25 @@ class CudaBackend final : public Backend {
   // upload_start_ and upload_end_ on the stream around the copy, or the wait for it.
   const UploadBuffers& upload(const PointCloud& cloud, bool with_times);
   DeviceScan deviceScan() const;
-  DeviceModelImage deviceModel(int buffer) const;
+  DeviceModelImage deviceModel(int buffer) const { return deviceImage(model_image_[buffer]); }
+  DeviceModelImage deviceImage(const SphericalBuffers& image) const;
   DeviceBev deviceBev(const BevBuffers& buffers, int count) const;
   DeviceBev scanGroundMap() const { return deviceBev(scan_ground_, kScanGroundPoints); }
   DeviceBev modelGroundMap(int buffer) const { return deviceBev(model_ground_[buffer], kModelPoints + buffer); }
+  DeviceBev mapGroundMap() const { return deviceBev(map_ground_, kMapGroundPoints); }
   CellCompaction compaction() const;
+  // The same, with the map render's per-source arrays.
+  CellCompaction mapCompaction() const;
+  void uploadMap(const MapCloud& map);
+  void clearMapModel();
+  // The Gauss-Newton sums of the scan against a model: the fused one or the map's.
+  NormalEquations linearizeAgainst(const DeviceModelImage& model, const DeviceBev& model_ground,
+                                   const GroundNormalCache& ground_normals, const Eigen::Isometry3d& model_from_scan,
+                                   double kernel_scale);
   // Copies count `count` into host_counts_ once the stream gets there.
   void fetchCount(int count);
   void copyBevView(const BevBuffers& buffers, int points, BevImage& view);
+  void copyModelView(const SphericalBuffers& image, const BevBuffers& ground, int ground_points, Model& view);
 
   Config config_;
   SphericalProjection spherical_;
@@ -148,13 +206,18 @@ class CudaBackend final : public Backend {
   // The model, twice: an update writes the buffer not in use (`1 - current_`), then switches to it.
   SphericalBuffers model_image_[2];
   BevBuffers model_ground_[2];
-  // The current model's ground normals, fitted when first matched (GroundNormalCache); a new epoch for
-  // every model.
-  DeviceArray<Float3> model_ground_normals_;
-  DeviceArray<unsigned> model_ground_normal_epochs_;
-  unsigned model_epoch_ = 1;
+  // The current model's ground normals, fitted when first matched; a new epoch for every model.
+  FittedGroundNormals model_ground_normals_;
   int current_ = 0;
   bool model_initialized_ = false;
+
+  // Localization: the map, the model last rendered from it and its ground normals.
+  MapBuffers map_;
+  SphericalBuffers map_image_;
+  BevBuffers map_ground_;
+  FittedGroundNormals map_ground_normals_;
+  bool map_set_ = false;
+  bool map_rendered_ = false;
 
   // Scratch of the BEV compaction (sources: every model point and every scan pixel).
   DeviceArray<ClosestKey> cell_keys_;
@@ -177,9 +240,11 @@ class CudaBackend final : public Backend {
   ScanImage scan_view_;
   BevImage scan_ground_view_;
   Model model_view_;
+  Model map_model_view_;
   bool scan_view_current_ = false;
   bool scan_ground_view_current_ = false;
   bool model_view_current_ = false;
+  bool map_model_view_current_ = false;
 
   // The scans' uploads: a prefetched cloud is staged on the uploads' own thread and copied on
   // upload_stream_, any other one here and on stream_. Last: its thread stops before the streams go.

@@ -12,6 +12,7 @@
 #include "core/common/closest_wins_key.hpp"
 #include "core/common/deskew.hpp"
 #include "core/common/ground.hpp"
+#include "core/common/map_render.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
 #include "core/common/point_to_plane.hpp"
@@ -94,6 +95,27 @@ void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, c
                         const Rigid3f& scan_from_model, const ModelFusion& fusion, ClosestKey* closest_keys,
                         ClosestKey* surface_keys, const DeviceModelImage& fused, cudaStream_t stream);
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
+
+// map_render.cu: localization's map model (common/map_render.hpp), as the CPU backend's renderMapModel()
+// draws it. The map lives on the device; a render reads the points `indices` lists.
+struct DeviceMap {
+  const Float3* points;
+  const Float3* normals;
+};
+// One render's sources and their scratch: each listed point and its normal in the sensor's frame.
+struct MapRenderSources {
+  const int32_t* indices;
+  int count;
+  Float3* vertices;
+  Float3* normals;
+};
+// The non-ground points with a normal go into `image`, closest wins per pixel over the discs they cover
+// (`closest_keys`: one per pixel, "none" before and again after); the ground points into `ground` by the
+// cell compaction, whose per-source arrays must hold `sources.count`.
+void renderMapModel(const DeviceMap& map, const MapRenderSources& sources, const Rigid3f& sensor_from_map,
+                    const SphericalProjection& spherical, const BevProjection& bev, const MapRendering& rendering,
+                    ClosestKey* closest_keys, const DeviceModelImage& image, const DeviceBev& ground,
+                    const CellCompaction& compaction, cudaStream_t stream);
 
 // correspondences.cu: the Gauss-Newton sums of both cost terms (Sec. III-A), packed as
 // point_to_plane.hpp lays them out, in one launch.

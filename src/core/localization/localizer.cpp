@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/common/map_render.hpp"
 #include "core/elapsed_time.hpp"
 #include "elo/registration.hpp"
 
@@ -16,7 +17,6 @@ namespace {
 constexpr int kCandidateIterations = 3;
 // The ground under a hint is looked for within this distance of it (m).
 constexpr double kGroundSearchRadius = 3.0;
-constexpr float kMinGroundNormalZ = 0.9f;
 
 MapMatchHealth healthOf(const RegistrationResult& registration) {
   const TermSums& nonground = registration.last.nonground;
@@ -94,11 +94,6 @@ Localizer::Localizer(Odometry& odometry, std::shared_ptr<const MapCloud> map)
       config_(odometry.config()),
       map_(checkedMap(std::move(map))),
       tiles_(*map_, odometry.config().localization.tile_size) {
-  if (!odometry_.backend().rendersMaps()) {
-    throw std::runtime_error(std::string("the ") + odometry_.backend().name() +
-                             " backend cannot localize on a map: map rendering is implemented on the CPU backend "
-                             "only (run localization with runtime.backend cpu)");
-  }
   odometry_.backend().setMap(map_);
 }
 
@@ -113,7 +108,7 @@ double Localizer::sensorHeightAt(const Eigen::Vector2d& xy) const {
   tiles_.pointsNear(Eigen::Vector3d(xy.x(), xy.y(), 0.0), kGroundSearchRadius, near);
   std::vector<float> heights;
   for (int32_t point : near) {
-    if (std::abs(map_->normals[point].z()) >= kMinGroundNormalZ) heights.push_back(map_->points[point].z());
+    if (std::abs(map_->normals[point].z()) >= kMinMapGroundNormalZ) heights.push_back(map_->points[point].z());
   }
   if (heights.empty()) return NAN;
   // The lower quartile: the road, not a roof or a car's top that lies within the disc.
