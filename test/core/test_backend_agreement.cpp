@@ -1,8 +1,8 @@
 // The CUDA backend against the CPU backend on the same inputs, stage by stage: range images, point
 // indices, ground labels and BEV maps identical (the scan's, the model's and a saved map's rendering);
 // normals within 1e-4; Gauss-Newton sums within 1e-6 (relative), and the GPU's the same bit for bit when
-// linearised again; poses within 1e-4 m and 1e-4 rad at every frame. These tests skip, saying why, where no CUDA device is usable or the build has no
-// CUDA backend. The factory tests run everywhere.
+// linearised again; poses within 1e-4 m and 1e-4 rad at every frame. These tests skip, saying why, where
+// no CUDA device is usable or the build has no CUDA backend. The factory tests run everywhere.
 #include <gtest/gtest.h>
 
 #include <filesystem>
