@@ -517,16 +517,18 @@ TEST(ColumnBits, PerPixelGroundLabelsAreThoseOfTheColumnWalk) {
   EXPECT_GT(nonground, 1000u);
 }
 
-// The pixels forEachSplatPixel() offers a point at (row, col), `range` away, with a disc of 1 m.
-std::set<std::pair<int, int>> splatPixels(const SphericalProjection& projection, int row, int col, float range) {
+// The pixels forEachSplatPixel() offers a point at (row, col), `range` away, with a disc of `radius`.
+std::set<std::pair<int, int>> splatPixels(const SphericalProjection& projection, int row, int col, float range,
+                                          float radius = 1.0f) {
   std::set<std::pair<int, int>> pixels;
-  forEachSplatPixel(projection, row, col, range, 1.0f,
+  forEachSplatPixel(projection, row, col, range, radius,
                     [&](int pixel) { pixels.insert({pixel / projection.cols, pixel % projection.cols}); });
   return pixels;
 }
 
 // A disc spans as many whole rows and columns either side as its angle covers: across the azimuth seam,
-// cut at the image's edge, at most 4 columns and 2 rows however close, and a far point its pixel alone.
+// cut at the image's edge, at most 4 columns and 2 rows however close (a point at the sensor too), and a
+// far point, or one without a disc, its pixel alone.
 TEST(MapRenderRules, ADiscCoversItsPixelsAcrossTheSeamUpToTheCap) {
   SphericalProjection projection;
   projection.rows = 10;
@@ -544,7 +546,10 @@ TEST(MapRenderRules, ADiscCoversItsPixelsAcrossTheSeamUpToTheCap) {
     for (int col = 46; col <= 54; ++col) expected.insert({row, col});
   }
   EXPECT_EQ(splatPixels(projection, 5, 50, 0.5f), expected);
-  EXPECT_EQ(splatPixels(projection, 9, 99, 100.0f), (std::set<std::pair<int, int>>{{9, 99}}));
+  EXPECT_EQ(splatPixels(projection, 5, 50, 0.0f), expected);  // at the sensor: an infinite angle
+  const std::set<std::pair<int, int>> alone{{9, 99}};
+  EXPECT_EQ(splatPixels(projection, 9, 99, 100.0f), alone);
+  EXPECT_EQ(splatPixels(projection, 9, 99, 0.0f, 0.0f), alone);  // no disc: 0 / 0
 }
 
 // A map point is ground in the band when its normal is near vertical (either way) or unknown; the

@@ -47,6 +47,14 @@ ELO_HOST_DEVICE inline float mapGroundAge(const Float3& point, const MapRenderin
   return point.z - rendering.ground_low;
 }
 
+// The whole pixels a disc spans either side of its own, `span` pixels wide, at most `cap`. A point at the
+// sensor (range 0, where sensor.min_range is 0) spans an infinite angle, or NaN without a disc: capped
+// before the conversion to int, which holds neither.
+ELO_HOST_DEVICE inline int splatHalfExtent(float span, int cap) {
+  if (span >= static_cast<float>(cap)) return cap;
+  return span > 0.0f ? static_cast<int>(span) : 0;
+}
+
 // Offers the point at (row, col), `range` away, to every pixel of the disc it spans: `offer(pixel)`.
 template <typename Offer>
 ELO_HOST_DEVICE void forEachSplatPixel(const SphericalProjection& projection, int row, int col, float range,
@@ -54,10 +62,8 @@ ELO_HOST_DEVICE void forEachSplatPixel(const SphericalProjection& projection, in
   const float angle = splat_radius / range;
   const float column_angle = 2.0f * static_cast<float>(M_PI) / static_cast<float>(projection.cols);
   const float row_angle = projection.fov_span / static_cast<float>(projection.rows);
-  const int columns = static_cast<int>(angle / column_angle);
-  const int rows = static_cast<int>(angle / row_angle);
-  const int half_width = columns < kMaxSplatColumns ? columns : kMaxSplatColumns;
-  const int half_height = rows < kMaxSplatRows ? rows : kMaxSplatRows;
+  const int half_width = splatHalfExtent(angle / column_angle, kMaxSplatColumns);
+  const int half_height = splatHalfExtent(angle / row_angle, kMaxSplatRows);
   const int top = row - half_height > 0 ? row - half_height : 0;
   const int bottom = row + half_height < projection.rows - 1 ? row + half_height : projection.rows - 1;
   for (int r = top; r <= bottom; ++r) {
