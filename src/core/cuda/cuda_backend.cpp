@@ -481,22 +481,23 @@ void CudaBackend::setMap(std::shared_ptr<const MapCloud> map) {
 // free memory is refused, saying how much it needs.
 void CudaBackend::uploadMap(const MapCloud& map) {
   const size_t count = map.size();
-  if (count > map_.capacity) {
+  const size_t capacity = map_.points.capacity();  // the normals' too: they grow together
+  if (count > capacity) {
     size_t free_bytes = 0;
     size_t total_bytes = 0;
     check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
     const size_t needed = count * 2 * sizeof(Float3);
-    const size_t held = map_.capacity * 2 * sizeof(Float3);  // freed before the new copy is allocated
+    const size_t held = capacity * 2 * sizeof(Float3);  // freed before the new copy is allocated
     if (needed > free_bytes + held) {
       constexpr double kMiB = 1024.0 * 1024.0;
+      const long available_mib = static_cast<long>((free_bytes + held) / kMiB);
       throw std::runtime_error("the map's " + std::to_string(count) + " points need " +
-                               std::to_string(static_cast<long>(needed / kMiB)) +
-                               " MiB on the GPU and " + std::to_string(static_cast<long>((free_bytes + held) / kMiB)) +
+                               std::to_string(static_cast<long>(needed / kMiB)) + " MiB on the GPU and " +
+                               std::to_string(available_mib) +
                                " MiB are free: localize on the CPU backend, or thin the map (a coarser voxel)");
     }
     map_.points.reserve(count);
     map_.normals.reserve(count);
-    map_.capacity = count;
   }
   check(cudaMemcpy(map_.points.data(), map.points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice),
         "uploading the map's points");

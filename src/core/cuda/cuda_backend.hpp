@@ -85,7 +85,6 @@ class CudaBackend final : public Backend {
   // drawn, staged and on the device, their vertices and normals in the sensor's frame, and the cell
   // compaction's per-source arrays. They grow with the largest render.
   struct MapBuffers {
-    size_t capacity = 0;  // points the map's arrays hold
     DeviceArray<Float3> points;
     DeviceArray<Float3> normals;
     PinnedArray<int32_t> staged_indices;

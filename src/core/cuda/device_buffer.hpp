@@ -41,6 +41,7 @@ class DeviceArray {
   }
 
   T* data() const { return data_; }
+  size_t capacity() const { return capacity_; }
 
  private:
   T* data_ = nullptr;
