@@ -21,7 +21,12 @@ export CUDA_MODULE_LOADING=EAGER  # module loading stays out of the first frame'
 failures=0
 rows=()
 
-row() { rows+=("$(printf '%-44s %s' "$1" "$2")"); }
+# Each row is printed as it is made too, so that a run cut short by the machine's time limit still says
+# what it found; the table at the end gathers them.
+row() {
+  rows+=("$(printf '%-44s %s' "$1" "$2")")
+  echo "[$(date +%T)] ${rows[-1]}"
+}
 fail() { failures=$((failures + 1)); row "$1" "FAIL: $2"; }
 
 # The agreement tests: every stage and whole drives, CPU against CUDA.
@@ -75,6 +80,7 @@ bench_row() {
   upload_ms=$(awk '/^scan upload to GPU/ {print $5}' <<<"$cuda")
   bench+=("$(printf '%-34s %8s %9s %9s %10s %10s %9s' "$name" "$points" "$cpu_fps" "$cuda_fps" \
     "$(awk -v f="$cuda_fps" 'BEGIN {printf "%.3f", 1000 / f}')" "${bare_fps:--}" "${upload_ms:--}")")
+  echo "[$(date +%T)] bench: ${bench[-1]}"
   echo "--- $name, CUDA" >>"$work/bench.log"
   echo "$cuda" >>"$work/bench.log"
 }
@@ -132,6 +138,9 @@ simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
 gpu=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -1)
 echo "GPU check: ${gpu:-no nvidia-smi}; $(nproc) CPU cores; nvcc $(nvcc --version 2>/dev/null | sed -n 's/.*release \([0-9.]*\).*/\1/p')"
 check_agreement
+# Localization first after the agreement tests: its map rendering is the newest CUDA code.
+simulate hdl64 urban curves "$work/hdl64"
+check_localization "HDL-64E, urban, $frames scans" "$work/hdl64"
 # The real scans deskewed by azimuth, so that every kernel of the odometry runs.
 for tool in memcheck racecheck synccheck; do
   summary="ERROR SUMMARY"
@@ -140,7 +149,6 @@ for tool in memcheck racecheck synccheck; do
 done
 
 bench=()
-simulate hdl64 urban curves "$work/hdl64"
 simulate vlp16 urban curves "$work/vlp16"
 simulate os1-128 urban curves "$work/os1_128"
 simulate hdl64 urban curves "$work/hdl64_distorted" --deskewed 0 --time-convention azimuth
@@ -155,7 +163,6 @@ bench_row "OS1-128, urban, $frames scans" "$work/os1_128" "$(mean_points "$work/
   --config "$configs/os1-128.yaml"
 [ -d "$scans" ] && bench_row "real HDL-64E, $(ls "$scans" | wc -l) scans" "$scans" "-"
 check_prefetch "HDL-64E, urban, $frames scans" "$work/hdl64"
-check_localization "HDL-64E, urban, $frames scans" "$work/hdl64"
 
 echo
 printf '%-44s %s\n' "check" "result"
