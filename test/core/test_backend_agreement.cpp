@@ -7,6 +7,8 @@
 
 #include <filesystem>
 #include <numeric>
+#include <sstream>
+#include <string>
 
 #include "analytic_scene.hpp"
 #include "elo/io/sequence.hpp"
@@ -493,6 +495,16 @@ TEST(BackendAgreement, MapMatchSumsAgree) {
 
 // Localization down the street on both backends, from a hint 1.5 m and 6 degrees off: the same states,
 // and poses within the odometry's tolerance at every scan.
+// One backend's localization of a scan, for a failure's message: a pose that differs after a search can
+// come from two candidates of nearly equal health ranked apart by the sums' last bits.
+std::string described(const LocalizationResult& result) {
+  std::ostringstream text;
+  text << (result.searched ? "searched" : "tracked") << ", inlier share " << result.health.inlier_share << ", rms "
+       << result.health.rms << ", " << result.health.inliers << " inliers, " << result.health.iterations
+       << " iterations" << (result.refusal.empty() ? "" : ", refused: " + result.refusal);
+  return text.str();
+}
+
 TEST(BackendAgreement, LocalizedPosesAgree) {
   ELO_REQUIRE_CUDA();
   const std::shared_ptr<MapCloud> map = streetMap(Config());
@@ -509,6 +521,7 @@ TEST(BackendAgreement, LocalizedPosesAgree) {
     const LocalizationResult a = cpu.update(odometry.cpu.process(cloud));
     const LocalizationResult b = cuda.update(odometry.cuda.process(cloud));
     state = a.state;
+    SCOPED_TRACE("CPU: " + described(a) + "; CUDA: " + described(b));
     ASSERT_EQ(a.state, b.state) << "frame " << frame;
     EXPECT_EQ(a.matched, b.matched) << "frame " << frame;
     EXPECT_EQ(a.map_points_rendered, b.map_points_rendered) << "frame " << frame;

@@ -18,7 +18,8 @@
 //  2. offerOldestOnClosestSurface: the second round, each source's first-arrival flag and each tile's
 //     count of first arrivals;
 //  3. writeWinners: a tile's first slot is the sum of the counts of the tiles before it (summed again by
-//     every block: a few hundred integers, cheaper than a launch), each first arrival's slot within the
+//     every block: a few hundred integers for a scan, a few thousand for a map's ground within the grid;
+//     a block sums them in microseconds, cheaper than a launch), each first arrival's slot within the
 //     tile a block scan of the flags; integer sums, exact in any order.
 #pragma once
 

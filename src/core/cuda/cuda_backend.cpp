@@ -1,5 +1,6 @@
 #include "core/cuda/cuda_backend.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,29 @@ void copyToHost(std::vector<Host>& host, const Device* device, size_t count, cud
   if (count == 0) return;
   check(cudaMemcpyAsync(host.data(), device, count * sizeof(Device), cudaMemcpyDeviceToHost, stream),
         "copying a buffer to the host");
+}
+
+// A copy from pageable host memory that has landed when this returns. A plain cudaMemcpy runs on the legacy
+// default stream, which the backend's non-blocking streams do not wait for, and may return before the data
+// reaches the device; copying on `stream` and waiting for it orders the copy before the stream's kernels.
+template <typename T>
+void uploadNow(const DeviceArray<T>& device, const void* host, size_t count, cudaStream_t stream, const char* what) {
+  if (count == 0) return;
+  check(cudaMemcpyAsync(device.data(), host, count * sizeof(T), cudaMemcpyHostToDevice, stream), what);
+  check(cudaStreamSynchronize(stream), what);
+}
+
+// Refuses an allocation of `needed` bytes that the device's free memory, with the `held` bytes that are
+// freed before it, cannot hold, saying what needs the memory and what the user can do instead.
+void requireDeviceMemory(size_t needed, size_t held, const std::string& what) {
+  size_t free_bytes = 0;
+  size_t total_bytes = 0;
+  check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
+  if (needed <= free_bytes + held) return;
+  constexpr double kMiB = 1024.0 * 1024.0;
+  throw std::runtime_error(what + " need " + std::to_string(static_cast<long>(needed / kMiB)) + " MiB on the GPU and " +
+                           std::to_string(static_cast<long>((free_bytes + held) / kMiB)) +
+                           " MiB are free: localize on the CPU backend, or thin the map (a coarser voxel)");
 }
 
 TermSums toTermSums(const DeviceTermSums& device) {
@@ -61,8 +85,14 @@ void CudaBackend::FittedGroundNormals::startEpoch(size_t points, cudaStream_t st
   if (++epoch == 0) clear(points, stream);  // wrapped: 0 means "none fitted"
 }
 
-// Room for a render of `sources` map points (CellCompaction's per-source arrays among them).
+// Room for a render of `sources` map points (CellCompaction's per-source arrays among them); a render larger
+// than the device's free memory allows is refused, saying so.
 void CudaBackend::MapBuffers::reserveRender(size_t sources) {
+  if (sources > indices.capacity()) {
+    constexpr size_t kBytesPerSource = sizeof(int32_t) + 2 * sizeof(Float3) + 2 * sizeof(int);
+    requireDeviceMemory(sources * kBytesPerSource, indices.capacity() * kBytesPerSource,
+                        "the " + std::to_string(sources) + " map points of one render");
+  }
   staged_indices.reserve(sources);
   indices.reserve(sources);
   source_vertices.reserve(sources);
@@ -97,8 +127,7 @@ CudaBackend::~CudaBackend() {
 
 void CudaBackend::allocate() {
   ring_rows_device_.reserve(ring_rows_.size());
-  check(cudaMemcpy(ring_rows_device_.data(), ring_rows_.data(), ring_rows_.size() * sizeof(int), cudaMemcpyHostToDevice),
-        "uploading the beam rows");
+  uploadNow(ring_rows_device_, ring_rows_.data(), ring_rows_.size(), stream_.get(), "uploading the beam rows");
   scan_image_.allocate(pixels_);
   point_indices_.reserve(pixels_);
   labels_.reserve(pixels_);
@@ -472,37 +501,28 @@ void CudaBackend::setMap(std::shared_ptr<const MapCloud> map) {
     throw std::invalid_argument("the map has no normals (prepareMap())");
   }
   synchronize();  // no kernel reads the map being replaced
-  map_set_ = map != nullptr;
-  if (map_set_ && map->size() > 0) uploadMap(*map);
+  // Until the new map is on the device there is none: a failed upload leaves no map to render.
+  map_set_ = false;
   clearMapModel();
+  if (map && map->size() > 0) uploadMap(*map);
+  map_set_ = map != nullptr;
 }
 
 // The map's points and normals, 24 bytes a point, copied once. A map that does not fit in the device's
 // free memory is refused, saying how much it needs.
 void CudaBackend::uploadMap(const MapCloud& map) {
   const size_t count = map.size();
-  const size_t capacity = map_.points.capacity();  // the normals' too: they grow together
+  // The smaller of the two: an allocation that failed halfway leaves the normals shorter.
+  const size_t capacity = std::min(map_.points.capacity(), map_.normals.capacity());
   if (count > capacity) {
-    size_t free_bytes = 0;
-    size_t total_bytes = 0;
-    check(cudaMemGetInfo(&free_bytes, &total_bytes), "cudaMemGetInfo");
-    const size_t needed = count * 2 * sizeof(Float3);
-    const size_t held = capacity * 2 * sizeof(Float3);  // freed before the new copy is allocated
-    if (needed > free_bytes + held) {
-      constexpr double kMiB = 1024.0 * 1024.0;
-      const long available_mib = static_cast<long>((free_bytes + held) / kMiB);
-      throw std::runtime_error("the map's " + std::to_string(count) + " points need " +
-                               std::to_string(static_cast<long>(needed / kMiB)) + " MiB on the GPU and " +
-                               std::to_string(available_mib) +
-                               " MiB are free: localize on the CPU backend, or thin the map (a coarser voxel)");
-    }
+    requireDeviceMemory(count * 2 * sizeof(Float3), capacity * 2 * sizeof(Float3),
+                        "the map's " + std::to_string(count) + " points");
     map_.points.reserve(count);
     map_.normals.reserve(count);
   }
-  check(cudaMemcpy(map_.points.data(), map.points.data(), count * sizeof(Float3), cudaMemcpyHostToDevice),
-        "uploading the map's points");
-  check(cudaMemcpy(map_.normals.data(), map.normals.data(), count * sizeof(Float3), cudaMemcpyHostToDevice),
-        "uploading the map's normals");
+  const cudaStream_t stream = stream_.get();
+  uploadNow(map_.points, map.points.data(), count, stream, "uploading the map's points");
+  uploadNow(map_.normals, map.normals.data(), count, stream, "uploading the map's normals");
 }
 
 // Before the first render, and after a new map: an empty model.
