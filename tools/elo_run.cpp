@@ -24,6 +24,7 @@
 #include "elo/io/scan_source.hpp"
 #include "elo/map_builder.hpp"
 #include "elo/odometry.hpp"
+#include "elo/sensor_fit.hpp"
 #include "command_line.hpp"
 #include "scan_sources.hpp"
 #include "localization_run.hpp"
@@ -510,6 +511,8 @@ int run(const Options& options) {
   const std::vector<elo::PlayedScan> played = elo::playOrder(*source, options.stride, options.reverse, options.max_frames);
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
+  const std::string normal_reach = elo::normalReachWarning(config);
+  if (!normal_reach.empty()) std::fprintf(stderr, "warning: %s\n", normal_reach.c_str());
   std::optional<MapOutput> map;
   if (!options.map_output.empty()) map.emplace(options.map_output, config.map);
   std::unique_ptr<elo::Localizer> localizer;

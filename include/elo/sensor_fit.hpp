@@ -41,4 +41,17 @@ constexpr double kMaxBeamOffsetDeg = 1.5;
 // correction, as the projection places them).
 SensorFit checkSensorFit(const PointCloud& cloud, const SensorConfig& sensor, size_t stride);
 
+// How far out a point still gets a normal (m), from the configuration alone. Test 1 of the normal's
+// outlier tests (Sec. III-B.4, normals.method range_adaptive) refuses a point when most of its window
+// lies farther than sigma_r (normals.outlier_distance), and the window spans at least three rows: the
+// beams above and below, range x tan(gap) away. With the paper's 0.5 m and beams 2 deg apart (a VLP-16)
+// no point beyond 14 m has a normal, and the heading slips where the near scene is bare
+// (docs/accuracy.md). The gap is the median between adjacent beams. Infinite for the other methods.
+double normalReach(const Config& config);
+
+// Empty when normalReach() is at least kMinNormalReach (or the sensor's max_range, if shorter); otherwise
+// the reach, the beams' gap and the normals.outlier_distance that reaches kMinNormalReach.
+std::string normalReachWarning(const Config& config);
+constexpr double kMinNormalReach = 25.0;  // m
+
 }  // namespace elo

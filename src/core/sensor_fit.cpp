@@ -1,6 +1,8 @@
 #include "elo/sensor_fit.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <vector>
 
@@ -12,6 +14,20 @@ namespace elo {
 namespace {
 
 double percent(size_t part, size_t whole) { return whole > 0 ? 100.0 * part / whole : 0.0; }
+
+// The median gap between adjacent beams (rad); 0 with fewer than two beams.
+double medianBeamGap(const SensorConfig& sensor) {
+  std::vector<float> elevations = beamElevations(sensor);
+  std::sort(elevations.begin(), elevations.end());
+  std::vector<double> gaps;
+  for (size_t beam = 1; beam < elevations.size(); ++beam) {
+    const double gap = static_cast<double>(elevations[beam]) - elevations[beam - 1];
+    if (gap > 0.0) gaps.push_back(gap);  // two lasers at one elevation are one row
+  }
+  if (gaps.empty()) return 0.0;
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  return gaps[gaps.size() / 2];
+}
 
 }  // namespace
 
@@ -61,6 +77,28 @@ std::string SensorFit::warning(const SensorConfig& sensor) const {
                 percent(misplaced(), sampled), sensor.name.c_str(), percent(above, sampled), sensor.fov_up_deg,
                 percent(below, sampled), sensor.fov_down_deg, percent(unknown_ring, sampled),
                 beamElevations(sensor).size(), percent(off_beam, sampled), kMaxBeamOffsetDeg);
+  return text;
+}
+
+double normalReach(const Config& config) {
+  const double gap = medianBeamGap(config.sensor);
+  if (config.normals.method != NormalMethod::range_adaptive || gap <= 0.0) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return config.normals.outlier_distance / std::tan(gap);
+}
+
+std::string normalReachWarning(const Config& config) {
+  const double reach = normalReach(config);
+  if (reach >= std::min(kMinNormalReach, config.sensor.max_range)) return "";
+  const double gap = medianBeamGap(config.sensor);
+  // Rounded up to 0.1 m, as a setting is written.
+  const double needed = std::ceil(10.0 * kMinNormalReach * std::tan(gap)) / 10.0;
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "points beyond %.0f m get no normal: the sensor's beams lie %.2f deg apart and "
+                "normals.outlier_distance is %.2f m; set it to %.1f m to reach %.0f m (docs/parameters.md)",
+                reach, gap * 180.0 / M_PI, config.normals.outlier_distance, needed, kMinNormalReach);
   return text;
 }
 

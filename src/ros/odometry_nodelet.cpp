@@ -6,6 +6,7 @@
 #include "elo/io/kitti.hpp"
 #include "elo/io/map_pcd.hpp"
 #include "elo/io/pcd.hpp"
+#include "elo/sensor_fit.hpp"
 
 namespace elo_ros {
 namespace {
@@ -34,6 +35,8 @@ void OdometryNodelet::onInit() {
     throw;
   }
   if (!odometry_->backendWarning().empty()) NODELET_WARN("%s", odometry_->backendWarning().c_str());
+  const std::string normal_reach = elo::normalReachWarning(odometry_->config());
+  if (!normal_reach.empty()) NODELET_WARN("%s", normal_reach.c_str());
   if (settings_.build_map) {
     map_ = std::make_unique<elo::MapBuilder>(odometry_->config().map, kMapQueue,
                                              [this](const elo::DriveMap& map, const elo::MapScan& scan) { publishMap(map, scan); });

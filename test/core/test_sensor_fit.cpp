@@ -120,5 +120,46 @@ TEST(SensorFit, SamplesEveryStrideThPoint) {
   EXPECT_EQ(fit.above, 2u);
 }
 
+// Sixteen beams 2 deg apart (a VLP-16), one of them doubled (two lasers at one elevation are one row).
+Config sixteenBeams(double outlier_distance) {
+  Config config;
+  config.sensor.beam_elevations_deg.clear();
+  for (int beam = 0; beam < 16; ++beam) config.sensor.beam_elevations_deg.push_back(15.0 - 2.0 * beam);
+  config.sensor.beam_elevations_deg.push_back(-1.0);
+  config.normals.outlier_distance = outlier_distance;
+  return config;
+}
+
+// The beams above and below lie range x tan(2 deg) away: 0.5 m at 14.3 m, 1.0 m at 28.6 m.
+TEST(NormalReach, IsWhereTheAdjacentBeamsLieSigmaRApart) {
+  EXPECT_NEAR(normalReach(sixteenBeams(0.5)), 0.5 / std::tan(2.0 * M_PI / 180.0), 1e-4);
+  EXPECT_NEAR(normalReach(sixteenBeams(0.5)), 14.318, 1e-3);
+  EXPECT_NEAR(normalReach(sixteenBeams(1.0)), 28.636, 1e-3);
+  // The HDL-64E's beams, 0.33 deg apart in the upper block and 0.5 in the lower: the median 0.5 deg.
+  EXPECT_NEAR(normalReach(Config()), 0.5 / std::tan(0.5 * M_PI / 180.0), 0.5);
+}
+
+TEST(NormalReach, WarnsBelowTheMinimumReachNamingTheSettingThatReachesIt) {
+  const std::string warning = normalReachWarning(sixteenBeams(0.5));
+  EXPECT_NE(warning.find("beyond 14 m"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("2.00 deg apart"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("set it to 0.9 m to reach 25 m"), std::string::npos) << warning;  // 25 tan(2 deg) = 0.87
+  EXPECT_EQ(normalReachWarning(sixteenBeams(0.9)), "");
+  EXPECT_EQ(normalReachWarning(Config()), "");
+}
+
+// A sensor that sees no farther than the reach, and estimators without test 1, lose nothing.
+TEST(NormalReach, DoesNotWarnWhereNoPointLiesBeyondItOrTheMethodHasNoDistanceTest) {
+  Config short_range = sixteenBeams(0.5);
+  short_range.sensor.max_range = 14.0;
+  EXPECT_EQ(normalReachWarning(short_range), "");
+  for (const NormalMethod method : {NormalMethod::eigen, NormalMethod::cross_product}) {
+    Config config = sixteenBeams(0.5);
+    config.normals.method = method;
+    EXPECT_TRUE(std::isinf(normalReach(config)));
+    EXPECT_EQ(normalReachWarning(config), "");
+  }
+}
+
 }  // namespace
 }  // namespace elo

@@ -96,6 +96,18 @@ TEST_F(EloRunCli, HelpDocumentsStrict) {
   EXPECT_TRUE(contains(result.output, "--strict")) << result.output;
 }
 
+// A sigma_r too small for the beams' spacing leaves far points without normals: elo_run says so at start,
+// naming the setting (the HDL-64E's beams, 0.5 deg apart at the median: 0.1 m reaches 11 m, 0.5 m 57 m).
+TEST_F(EloRunCli, WarnsWhenFarPointsGetNoNormal) {
+  const CommandResult narrow = runEloRun("--frames 1 --set normals.outlier_distance=0.1");
+  EXPECT_EQ(narrow.exit_code, 0) << narrow.output;
+  EXPECT_TRUE(contains(narrow.output, "warning: points beyond 11 m get no normal")) << narrow.output;
+  EXPECT_TRUE(contains(narrow.output, "normals.outlier_distance is 0.10 m; set it to 0.3 m")) << narrow.output;
+  const CommandResult papers = runEloRun("--frames 1");
+  EXPECT_EQ(papers.exit_code, 0) << papers.output;
+  EXPECT_FALSE(contains(papers.output, "get no normal")) << papers.output;
+}
+
 TEST_F(EloRunCli, TruncatedLastScanIsSkippedAndRepeatsTheLastPose) {
   truncate(scanPath(sequence_, kScans - 1));
   const CommandResult result = runEloRun();
