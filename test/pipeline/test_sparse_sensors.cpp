@@ -2,7 +2,8 @@
 // the heading error's sign, the horizontal drift and the heading slip. A drive and its mirror image (left
 // turns made right ones) must drift in heading by opposite amounts, so that their mean per-scan heading
 // error, the pipeline's one-signed part, is near zero. And the issue's targets on thin stretches and
-// around a roundabout. Drives of 140-790 m, run in every test run.
+// around a roundabout. Drives of 140-790 m, run in every test run; test_sparse_sensors_long
+// (ELO_SPARSE_SENSORS_LONG, label pipeline-long) drives every other sparse sensor around the roundabout.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,6 +81,11 @@ sim::SimulationSpec driveIn(sim::WorldFamily world, sim::TrajectoryKind trajecto
   return spec;
 }
 
+sim::SimulationSpec urbanRoundabout(uint64_t seed) {
+  return driveIn(sim::WorldFamily::urban, sim::TrajectoryKind::roundabout, 1050, seed);
+}
+
+#ifndef ELO_SPARSE_SENSORS_LONG
 sim::SimulationSpec curvesIn(sim::WorldFamily world, int frames, uint64_t seed, bool mirrored = false) {
   return driveIn(world, sim::TrajectoryKind::curves, frames, seed, mirrored);
 }
@@ -132,10 +138,40 @@ TEST(SparseSensors, ThinStretchesHoldTheTargets) {
 // t_rel 0.036 %, horizontal 0.023 %, r_rel 0.026 deg/100 m, largest slip over 10 scans 0.026 deg (0.212 %
 // and 0.31 deg before config/vlp16.yaml's outlier distance and weight). Seeds 3 and 11: 0.041 and 0.044 %.
 TEST(SparseSensors, Vlp16RoundaboutHoldsTheTargets) {
-  const SparseDrive vlp16 = drive("vlp16", driveIn(sim::WorldFamily::urban, sim::TrajectoryKind::roundabout, 1050, 7));
+  const SparseDrive vlp16 = drive("vlp16", urbanRoundabout(7));
   EXPECT_GT(vlp16.evaluation.length_m, 780.0);
   expectVlp16Targets(vlp16);
 }
+#else
+// Every other sensor whose beams lie 1 deg or more apart, configured as shipped, around the same
+// roundabout: each needs its config's normals.outlier_distance (docs/accuracy.md, "every sensor's normals
+// at range"). Measured t_rel % with it (without, at the paper's 0.5 m): xt32 0.013 (0.016), xt32m 0.017
+// (0.113), hdl32 0.022 (0.027), os0-64 0.018 (0.126), qt64 0.027 (0.155), xt16 0.037 (0.435), helios16
+// 0.029 (0.129), helios5515 0.020 (0.044); the Bpearl, a hemisphere that sees little but the road, 0.207
+// (lost at 0.5 m). Bounds: the VLP-16's targets' tenths, 0.06 % t_rel, which five of them broke at 0.5 m;
+// the Bpearl 0.3 %.
+class SparseSensorRoundabout : public testing::TestWithParam<const char*> {};
+
+TEST_P(SparseSensorRoundabout, HoldsItsHeadingAndDrift) {
+  const std::string sensor = GetParam();
+  const SparseDrive run = drive(sensor, urbanRoundabout(7));
+  const double bound = sensor == "bpearl" ? 0.3 : 0.06;
+  EXPECT_GT(run.evaluation.length_m, 780.0);
+  EXPECT_LT(run.evaluation.drift.t_rel_percent, bound);
+  EXPECT_LT(run.evaluation.drift.t_rel_horizontal_percent, bound);
+  EXPECT_LT(run.evaluation.drift.r_rel_deg_per_100m, 0.2);
+  EXPECT_LT(run.largest_slip_deg, 0.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sensors, SparseSensorRoundabout,
+                         testing::Values("xt32", "xt32m", "hdl32", "os0-64", "qt64", "xt16", "helios16",
+                                         "helios5515", "bpearl"),
+                         [](const testing::TestParamInfo<const char*>& info) {
+                           std::string name = info.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
+#endif
 
 }  // namespace
 }  // namespace elo
