@@ -493,8 +493,6 @@ TEST(BackendAgreement, MapMatchSumsAgree) {
   }
 }
 
-// Localization down the street on both backends, from a hint 1.5 m and 6 degrees off: the same states,
-// and poses within the odometry's tolerance at every scan.
 // One backend's localization of a scan, for a failure's message: a pose that differs after a search can
 // come from two candidates of nearly equal health ranked apart by the sums' last bits.
 std::string described(const LocalizationResult& result) {
@@ -505,6 +503,8 @@ std::string described(const LocalizationResult& result) {
   return text.str();
 }
 
+// Localization down the street on both backends, from a hint 1.5 m and 6 degrees off: the same states,
+// and poses within the odometry's tolerance at every scan.
 TEST(BackendAgreement, LocalizedPosesAgree) {
   ELO_REQUIRE_CUDA();
   const std::shared_ptr<MapCloud> map = streetMap(Config());

@@ -148,8 +148,8 @@ TEST(SparseSensors, Vlp16RoundaboutHoldsTheTargets) {
 // at range"). Measured t_rel % with it (without, at the paper's 0.5 m): xt32 0.013 (0.016), xt32m 0.017
 // (0.113), hdl32 0.022 (0.027), os0-64 0.018 (0.126), qt64 0.027 (0.155), xt16 0.037 (0.435), helios16
 // 0.029 (0.129), helios5515 0.020 (0.044); the Bpearl, a hemisphere that sees little but the road, 0.207
-// (lost at 0.5 m). Bounds: the VLP-16's targets' tenths, 0.06 % t_rel, which five of them broke at 0.5 m;
-// the Bpearl 0.3 %.
+// (lost at 0.5 m). Bounds: 0.06 % t_rel, under a third of the VLP-16's target (0.2 %), which five of them
+// broke at 0.5 m; the Bpearl 0.3 %.
 class SparseSensorRoundabout : public testing::TestWithParam<const char*> {};
 
 TEST_P(SparseSensorRoundabout, HoldsItsHeadingAndDrift) {
