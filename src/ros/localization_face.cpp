@@ -77,10 +77,20 @@ LocalizationFace::LocalizationFace(ros::NodeHandle& node, ros::NodeHandle& priva
 LocalizationFace::Messages LocalizationFace::update(const elo::FrameResult& result, const FrameBinding& frames,
                                                     const ros::Time& stamp) {
   frames_ = frames;
-  const elo::LocalizationResult localized = localizer_->update(result);
+  elo::LocalizationResult localized;
+  try {
+    localized = localizer_->update(result);
+  } catch (const std::exception& error) {
+    ROS_ERROR_THROTTLE(5.0, "localization failed on this scan, which keeps the odometry's pose: %s", error.what());
+    std::lock_guard<std::mutex> lock(report_mutex_);
+    ++failed_scans_;
+    last_failure_ = error.what();
+    return {};
+  }
   {
     std::lock_guard<std::mutex> lock(report_mutex_);
     last_ = localized;
+    last_failure_.clear();
     ++scans_;
   }
   if (!localized.refusal.empty()) ROS_WARN_THROTTLE(5.0, "localization: match refused: %s", localized.refusal.c_str());
@@ -156,8 +166,10 @@ void LocalizationFace::report(diagnostic_updater::DiagnosticStatusWrapper& statu
       status.summary(DiagnosticStatus::ERROR, "lost: map matches refused; give a pose (/initialpose)");
       break;
   }
+  if (!last_failure_.empty()) status.summary(DiagnosticStatus::ERROR, "failing: " + last_failure_);
   status.add("map", settings_.map_file);
   status.add("scans localized", scans_);
+  status.add("scans failed", failed_scans_);
   status.add("inlier share", last_.health.inlier_share);
   status.add("point-to-plane RMS (m)", last_.health.rms);
   status.add("scans since the last accepted match", last_.scans_since_match);

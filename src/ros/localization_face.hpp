@@ -45,12 +45,15 @@ class LocalizationFace {
   LocalizationFace(ros::NodeHandle& node, ros::NodeHandle& private_node, const LocalizationSettings& settings,
                    elo::Odometry& odometry, std::mutex& odometry_mutex);
 
-  // Under the odometry lock, after `odometry.process()` returned `result`.
+  // Under the odometry lock, after `odometry.process()` returned `result`. A scan the backend cannot
+  // render the map for (the CUDA backend: the map's part near the vehicle does not fit in the device's
+  // free memory) is logged, counted in the diagnostics and left unlocalized; the odometry goes on.
   Messages update(const elo::FrameResult& result, const FrameBinding& frames, const ros::Time& stamp);
   // Under the odometry lock: the odometry was reset by its service.
   void odometryReset() { localizer_->odometryRestarted(); }
   void publish(const Messages& messages);
-  // For diagnostic_updater: OK while tracking, WARN while waiting for a pose, ERROR when lost.
+  // For diagnostic_updater: OK while tracking, WARN while waiting for a pose, ERROR when lost or when the
+  // last scan failed.
   void report(diagnostic_updater::DiagnosticStatusWrapper& status);
 
  private:
@@ -64,6 +67,8 @@ class LocalizationFace {
   std::mutex report_mutex_;
   elo::LocalizationResult last_;
   size_t scans_ = 0;
+  size_t failed_scans_ = 0;
+  std::string last_failure_;  // empty when the last scan did not fail
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::Publisher pose_publisher_;
   ros::Publisher map_publisher_;  // latched, once

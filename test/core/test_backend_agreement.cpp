@@ -433,6 +433,18 @@ std::vector<int32_t> everyNth(size_t count, size_t step) {
   return points;
 }
 
+// `points` of the map rendered from `at` on both backends: the same images and ground maps.
+void expectSameRenderings(Backends& backends, const std::vector<int32_t>& points, const Eigen::Isometry3d& at,
+                          size_t least_ground) {
+  backends.cpu->renderMap(points, at);
+  backends.cuda->renderMap(points, at);
+  const Model& cpu = backends.cpu->mapModel();
+  const Model& cuda = backends.cuda->mapModel();
+  EXPECT_GT(cpu.ground.size(), least_ground);
+  expectSameGroundMap(cpu.ground, cuda.ground);
+  expectAgreeingModelImage(cpu.nonground, cuda.nonground);
+}
+
 // The map rendered from the same pose on both backends: the same pixels, vertices and ranges, and the
 // same ground map in the same order; with and without the discs, from all points or a list of some, and
 // from none.
@@ -448,14 +460,7 @@ TEST(BackendAgreement, MapRenderingsAreIdentical) {
     for (const size_t step : {1, 3}) {
       for (const Eigen::Isometry3d& at : {pose(-12, 0.3, 0, 0, 0, 2), pose(-8, -0.5, 0.1, 1, -1, 12)}) {
         SCOPED_TRACE("splat " + std::to_string(splat_radius) + ", every " + std::to_string(step) + " point");
-        const std::vector<int32_t> points = everyNth(map->size(), step);
-        backends.cpu->renderMap(points, at);
-        backends.cuda->renderMap(points, at);
-        const Model& cpu = backends.cpu->mapModel();
-        const Model& cuda = backends.cuda->mapModel();
-        EXPECT_GT(cpu.ground.size(), 1000u);
-        expectSameGroundMap(cpu.ground, cuda.ground);
-        expectAgreeingModelImage(cpu.nonground, cuda.nonground);
+        expectSameRenderings(backends, everyNth(map->size(), step), at, 1000);
       }
     }
     backends.cpu->renderMap({}, pose(-12, 0, 0, 0, 0, 0));
@@ -464,6 +469,29 @@ TEST(BackendAgreement, MapRenderingsAreIdentical) {
     EXPECT_EQ(cuda.ground.size(), 0u);
     const std::vector<float>& ranges = cuda.nonground.range;
     EXPECT_EQ(std::count_if(ranges.begin(), ranges.end(), [](float range) { return range > 0.0f; }), 0);
+  }
+}
+
+// Renders down the street within 10 m of the sensor, with 4 m tiles: the GPU holds a few tiles of the map
+// at a time and takes others up as the renders move on (MapResidency), then all of it for one render of
+// every point, then few again. The same images and ground maps as the CPU's, which reads the whole map.
+TEST(BackendAgreement, MapRenderingsAgreeWhileTheTilesHeldChange) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.localization.tile_size = 4.0;
+  const std::shared_ptr<MapCloud> map = streetMap(config);
+  const MapTiles tiles(*map, config.localization.tile_size);
+  Backends backends(config);
+  backends.cpu->setMap(map);
+  backends.cuda->setMap(map);
+  std::vector<int32_t> all(map->size());
+  std::iota(all.begin(), all.end(), 0);
+  for (const double x : {-22.0, -18.0, -13.0, -8.0, -4.0, 0.0, -30.0, -10.0}) {
+    SCOPED_TRACE("at x " + std::to_string(x));
+    const Eigen::Isometry3d at = pose(x, 0.2, 0.0, 0.0, 0.0, 3.0);
+    std::vector<int32_t> near;
+    tiles.pointsNear(at.translation(), 10.0, near);
+    expectSameRenderings(backends, x == -30.0 ? all : near, at, 100);
   }
 }
 

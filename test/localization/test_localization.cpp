@@ -4,8 +4,10 @@
 // vehicle. ELO_LOCALIZATION_LONG builds the long gates (over a kilometre) instead of the short ones.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 
+#include "core/localization/map_residency.hpp"
 #include "elo/localization/localizer.hpp"
 #include "elo/sim/sensors.hpp"
 #include "shared_world.hpp"
@@ -217,6 +219,42 @@ TEST_F(Localization, AKidnappedVehicleIsDetectedAndRelocalizedFromAHint) {
   std::printf("kidnapped 50 m: detected after %d scans, relocalized in %.0f ms; worst error over the next 19 scans %.3f m\n",
               detected, relocalized.milliseconds, worst);
   EXPECT_LT(worst, 0.2);
+}
+
+// The part of the map the CUDA backend holds (MapResidency) along the other drive, rendered where each
+// scan truly is, as a localized drive renders it: every render finds its points held, and over the long
+// drive the device holds a part of the map bounded by the render's reach, not the map.
+TEST_F(Localization, AGpuHoldsOnlyThePartOfTheMapNearTheDrive) {
+  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
+  const Config config = sensorConfig("hdl64");
+  const MapTiles tiles(*map_, config.localization.tile_size);
+  MapResidency residency(*map_, config.localization.tile_size);
+  int sets = 0;
+  double choosing = 0.0;  // ms, on the host
+  size_t most_held = 0;
+  std::vector<int32_t> drawn;
+  std::vector<int32_t> places;
+  for (int frame = 0; frame < drive.frameCount(); ++frame) {
+    drawn.clear();
+    tiles.pointsNear(drive.pose(frame).translation(), config.localization.render_range, drawn);
+    places.resize(drawn.size());
+    if (residency.locate(drawn, places.data())) continue;
+    const auto start = std::chrono::steady_clock::now();
+    residency.holdAround(drawn);
+    choosing += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    ++sets;
+    most_held = std::max(most_held, residency.held().size());
+    ASSERT_TRUE(residency.locate(drawn, places.data())) << "scan " << frame;
+    for (size_t i = 0; i < drawn.size(); ++i) ASSERT_EQ(residency.held()[places[i]], drawn[i]) << "scan " << frame;
+  }
+  std::printf("the GPU's part of the map over %d scans: %d sets (%.1f ms each to choose), at most %zu of the map's "
+              "%zu points (%.0f %%)\n",
+              drive.frameCount(), sets, choosing / std::max(sets, 1), most_held, map_->size(),
+              100.0 * most_held / map_->size());
+  EXPECT_GE(sets, 1);
+#ifdef ELO_LOCALIZATION_LONG
+  EXPECT_LT(most_held, map_->size() / 3);
+#endif
 }
 
 }  // namespace

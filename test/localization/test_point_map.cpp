@@ -1,5 +1,5 @@
 // The saved map of localization: loading and cleaning it, its normals, its tile index, and rendering it
-// into a backend's map model, on analytic maps with exact answers.
+// into a backend's map model, and the part of it a GPU holds, on analytic maps with exact answers.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -13,6 +13,7 @@
 #include "elo/backend.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/map_pcd.hpp"
+#include "core/localization/map_residency.hpp"
 #include "elo/localization/point_map.hpp"
 
 namespace elo {
@@ -82,6 +83,53 @@ TEST(MapCloud, TilesFindExactlyThePointsWithinTheRadius) {
       EXPECT_EQ(found, expected) << "tile " << tile << " centre " << center.transpose();
     }
   }
+}
+
+// The CUDA backend's share of the map (MapResidency) down a 1 km road, rendered every 2 m within 60 m:
+// every render finds its points held and where it was told, a new set is chosen once every two tiles
+// travelled (the ring around the drawn tiles is what spares the tile in between), and the device holds
+// only the tiles within the render's reach and one more: a fifth of the map, not all of it.
+TEST(MapResidency, HoldsOnlyTheTilesNearTheRendersAndFindsEveryPointDrawn) {
+  MapCloud map;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> along(-500.0f, 500.0f);
+  std::uniform_real_distribution<float> across(-20.0f, 20.0f);
+  for (int i = 0; i < 20000; ++i) map.points.emplace_back(along(random), across(random), 0.0f);
+  constexpr double kTile = 20.0;
+  constexpr double kReach = 60.0;
+  const MapTiles tiles(map, kTile);
+  MapResidency residency(map, kTile);
+  int choices = 0;
+  size_t most_held = 0;
+  for (double x = -490.0; x <= 490.0; x += 2.0) {
+    std::vector<int32_t> drawn;
+    tiles.pointsNear(Eigen::Vector3d(x, 0.0, 0.0), kReach, drawn);
+    std::vector<int32_t> places(drawn.size());
+    if (!residency.locate(drawn, places.data())) {
+      residency.holdAround(drawn);
+      ++choices;
+      for (const int32_t point : residency.held()) {
+        ASSERT_LE(std::abs(map.points[point].x() - x), kReach + 2 * kTile) << "a tile beyond the ring, at x " << x;
+      }
+      most_held = std::max(most_held, residency.held().size());
+      ASSERT_TRUE(residency.locate(drawn, places.data())) << "at x " << x;
+    }
+    for (size_t i = 0; i < drawn.size(); ++i) ASSERT_EQ(residency.held()[places[i]], drawn[i]) << "at x " << x;
+  }
+  std::printf("%d sets held over 980 m; at most %zu of the map's %zu points\n", choices, most_held, map.size());
+  EXPECT_LE(choices, 1 + 980 / 40);
+  EXPECT_LE(most_held, map.size() / 4);
+  EXPECT_GT(most_held, map.size() / 10);
+
+  residency.release();
+  EXPECT_TRUE(residency.held().empty());
+  std::vector<int32_t> drawn;
+  tiles.pointsNear(Eigen::Vector3d(0.0, 0.0, 0.0), kReach, drawn);
+  std::vector<int32_t> places(drawn.size());
+  EXPECT_FALSE(residency.locate(drawn, places.data()));
+  residency.holdAround({});
+  EXPECT_TRUE(residency.held().empty());
+  EXPECT_TRUE(residency.locate({}, places.data()));
 }
 
 class MapFile : public testing::Test {

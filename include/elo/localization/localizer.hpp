@@ -64,8 +64,9 @@ struct LocalizationResult {
 class Localizer {
  public:
   // Localizes `odometry`'s scans in `map` (prepared: with normals). Throws std::invalid_argument for an
-  // empty map or one without normals, and std::runtime_error when the backend cannot hold the map (the
-  // CUDA backend: larger than the device's free memory).
+  // empty map or one without normals. update() throws std::runtime_error when the backend cannot render
+  // the map near the vehicle (the CUDA backend: that part of the map does not fit in the device's free
+  // memory).
   Localizer(Odometry& odometry, std::shared_ptr<const MapCloud> map);
 
   // The sensor's pose in the map near the next scan: that scan searches around it (localization.search_*

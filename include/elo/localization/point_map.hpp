@@ -35,17 +35,26 @@ void estimateMapNormals(MapCloud& map, double radius);
 // Square tiles of the map's x-y plane, `tile_size` wide, each listing its points.
 class MapTiles {
  public:
+  // A tile's place in the grid: its column (along x) and row (along y).
+  struct Cell {
+    int64_t col;
+    int64_t row;
+  };
+
   MapTiles(const MapCloud& map, double tile_size);
 
   // The points within `radius` (in x-y) of `center`, appended to `out` in tile order.
   void pointsNear(const Eigen::Vector3d& center, double radius, std::vector<int32_t>& out) const;
   size_t tileCount() const { return tiles_.size(); }
+  // The tile `point` lies in, and the points of the tile at `cell` (null when none lies there).
+  Cell cellOf(const Vec3f& point) const;
+  const std::vector<int32_t>* pointsIn(const Cell& cell) const;
   // The map's extent in x-y: its lower and upper corners (zero for an empty map).
   Eigen::Vector2d lower() const { return lower_; }
   Eigen::Vector2d upper() const { return upper_; }
 
  private:
-  static uint64_t key(int64_t col, int64_t row);
+  static uint64_t key(const Cell& cell);
   const MapCloud& map_;
   double tile_size_;
   std::unordered_map<uint64_t, std::vector<int32_t>> tiles_;

@@ -501,28 +501,44 @@ void CudaBackend::setMap(std::shared_ptr<const MapCloud> map) {
     throw std::invalid_argument("the map has no normals (prepareMap())");
   }
   synchronize();  // no kernel reads the map being replaced
-  // Until the new map is on the device there is none: a failed upload leaves no map to render.
-  map_set_ = false;
   clearMapModel();
-  if (map && map->size() > 0) uploadMap(*map);
-  map_set_ = map != nullptr;
+  map_residency_.reset();  // it refers to the map
+  map_cloud_ = std::move(map);
+  if (map_cloud_) map_residency_ = std::make_unique<MapResidency>(*map_cloud_, config_.localization.tile_size);
 }
 
-// The map's points and normals, 24 bytes a point, copied once. A map that does not fit in the device's
-// free memory is refused, saying how much it needs.
-void CudaBackend::uploadMap(const MapCloud& map) {
-  const size_t count = map.size();
+void CudaBackend::holdMapAround(const std::vector<int32_t>& points) {
+  map_residency_->holdAround(points);
+  try {
+    uploadHeldMap();
+  } catch (...) {
+    map_residency_->release();  // what it says it holds is not all on the device
+    throw;
+  }
+}
+
+// The held points and their normals, 24 bytes a point. A part that does not fit in the device's free
+// memory is refused, saying how much it needs.
+void CudaBackend::uploadHeldMap() {
+  const std::vector<int32_t>& held = map_residency_->held();
+  const size_t count = held.size();
   // The smaller of the two: an allocation that failed halfway leaves the normals shorter.
   const size_t capacity = std::min(map_.points.capacity(), map_.normals.capacity());
   if (count > capacity) {
     requireDeviceMemory(count * 2 * sizeof(Float3), capacity * 2 * sizeof(Float3),
-                        "the map's " + std::to_string(count) + " points");
+                        "the " + std::to_string(count) + " map points near the vehicle");
     map_.points.reserve(count);
     map_.normals.reserve(count);
   }
+  std::vector<Vec3f> points(count);
+  std::vector<Vec3f> normals(count);
+  for (size_t slot = 0; slot < count; ++slot) {
+    points[slot] = map_cloud_->points[held[slot]];
+    normals[slot] = map_cloud_->normals[held[slot]];
+  }
   const cudaStream_t stream = stream_.get();
-  uploadNow(map_.points, map.points.data(), count, stream, "uploading the map's points");
-  uploadNow(map_.normals, map.normals.data(), count, stream, "uploading the map's normals");
+  uploadNow(map_.points, points.data(), count, stream, "uploading the map's points");
+  uploadNow(map_.normals, normals.data(), count, stream, "uploading the map's normals");
 }
 
 // Before the first render, and after a new map: an empty model.
@@ -537,15 +553,19 @@ void CudaBackend::clearMapModel() {
 }
 
 void CudaBackend::renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) {
-  if (!map_set_) throw std::logic_error("renderMap() before setMap()");
+  if (!map_residency_) throw std::logic_error("renderMap() before setMap()");
   const cudaStream_t stream = stream_.get();
-  synchronize();  // the last render's copy has read the staged indices
+  synchronize();  // the last render's copy has read the staged places, and no kernel reads the held map
   map_.reserveRender(points.size());
+  int32_t* const places = map_.staged_indices.data();
+  if (!map_residency_->locate(points, places)) {
+    holdMapAround(points);
+    map_residency_->locate(points, places);
+  }
   if (!points.empty()) {
-    std::memcpy(map_.staged_indices.data(), points.data(), points.size() * sizeof(int32_t));
-    check(cudaMemcpyAsync(map_.indices.data(), map_.staged_indices.data(), points.size() * sizeof(int32_t),
-                          cudaMemcpyHostToDevice, stream),
-          "uploading the map points to render");
+    check(cudaMemcpyAsync(map_.indices.data(), places, points.size() * sizeof(int32_t), cudaMemcpyHostToDevice,
+                          stream),
+          "uploading the places of the map points to render");
   }
   const MapRenderSources sources{map_.indices.data(), static_cast<int>(points.size()), map_.source_vertices.data(),
                                  map_.source_normals.data()};

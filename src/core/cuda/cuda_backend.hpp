@@ -1,10 +1,11 @@
 // The CUDA implementation of the backend interface: the stages of src/core/cuda/*.cu, queued on one
 // stream over device buffers that mirror include/elo/types.hpp and are allocated once, in the
 // constructor (only the cloud upload grows, when a scan has more points than any before, and
-// localization's map and render buffers, with the map and the largest render). The scan
-// goes up through pinned memory, in one of two upload buffers: the next scan, when prefetched, is staged
-// into the other one on a thread of its own and copied on a stream of its own while this one is
-// processed. The host views are copied back when asked for, and only when the device buffers changed since.
+// localization's map and render buffers, with the largest part of the map held and the largest
+// render). The scan goes up through pinned memory, in one of two upload buffers: the next scan, when
+// prefetched, is staged into the other one on a thread of its own and copied on a stream of its own
+// while this one is processed. The host views are copied back when asked for, and only when the device
+// buffers changed since.
 #pragma once
 
 #include <memory>
@@ -13,6 +14,7 @@
 #include "core/cuda/device_buffer.hpp"
 #include "core/double_buffered_upload.hpp"
 #include "core/cuda/kernels.hpp"
+#include "core/localization/map_residency.hpp"
 #include "elo/backend.hpp"
 
 namespace elo::cuda {
@@ -36,8 +38,8 @@ class CudaBackend final : public Backend {
   const BevImage& scanGround() override;
   const Model& model() override;
 
-  // Localization (renderMap()): the map is uploaded once and stays on the device; a render uploads the
-  // indices of the points it draws.
+  // Localization (renderMap()): the device holds the map's tiles near the renders (MapResidency), copied
+  // up when a render needs one it does not hold; a render uploads the places of the points it draws.
   void setMap(std::shared_ptr<const MapCloud> map) override;
   void renderMap(const std::vector<int32_t>& points, const Eigen::Isometry3d& map_from_sensor) override;
   NormalEquations linearizeMap(const Eigen::Isometry3d& rendered_from_scan, double kernel_scale) override;
@@ -81,9 +83,10 @@ class CudaBackend final : public Backend {
     void startEpoch(size_t points, cudaStream_t stream);
     GroundNormalCache cache() const { return {normals.data(), epochs.data(), epoch}; }
   };
-  // Localization's map on the device (setMap()), and one render's sources: the indices of the points
-  // drawn, staged and on the device, their vertices and normals in the sensor's frame, and the cell
-  // compaction's per-source arrays. They grow with the largest render.
+  // The part of localization's map the device holds (MapResidency::held()), and one render's sources: the
+  // places there of the points drawn, staged and on the device, their vertices and normals in the
+  // sensor's frame, and the cell compaction's per-source arrays. They grow with the largest part held and
+  // the largest render.
   struct MapBuffers {
     DeviceArray<Float3> points;
     DeviceArray<Float3> normals;
@@ -155,7 +158,9 @@ class CudaBackend final : public Backend {
   CellCompaction compaction() const;
   // The same, with the map render's per-source arrays.
   CellCompaction mapCompaction() const;
-  void uploadMap(const MapCloud& map);
+  // Holds the map's tiles around `points` and copies them up; on a failure, holds nothing.
+  void holdMapAround(const std::vector<int32_t>& points);
+  void uploadHeldMap();
   void clearMapModel();
   // The Gauss-Newton sums of the scan against a model: the fused one or the map's.
   NormalEquations linearizeAgainst(const DeviceModelImage& model, const DeviceBev& model_ground,
@@ -210,12 +215,14 @@ class CudaBackend final : public Backend {
   int current_ = 0;
   bool model_initialized_ = false;
 
-  // Localization: the map, the model last rendered from it and its ground normals.
+  // Localization: the map, the part of it held on the device, the model last rendered from it and its
+  // ground normals.
+  std::shared_ptr<const MapCloud> map_cloud_;
+  std::unique_ptr<MapResidency> map_residency_;  // null: no map set
   MapBuffers map_;
   SphericalBuffers map_image_;
   BevBuffers map_ground_;
   FittedGroundNormals map_ground_normals_;
-  bool map_set_ = false;
   bool map_rendered_ = false;
 
   // Scratch of the BEV compaction (sources: every model point and every scan pixel).

@@ -97,7 +97,8 @@ void fuseSphericalModel(const DeviceModelImage& model, const DeviceScan& scan, c
 void copyScanToModel(const DeviceScan& scan, const DeviceModelImage& model, cudaStream_t stream);
 
 // map_render.cu: localization's map model (common/map_render.hpp), as the CPU backend's renderMapModel()
-// draws it. The map lives on the device; a render reads the points `indices` lists.
+// draws it. The part of the map a render needs lives on the device (MapResidency); a render reads the
+// points `indices` lists, their places there.
 struct DeviceMap {
   const Float3* points;
   const Float3* normals;

@@ -132,14 +132,22 @@ MapTiles::MapTiles(const MapCloud& map, double tile_size) : map_(map), tile_size
     const Eigen::Vector2d xy = map.points[i].head<2>().cast<double>();
     lower_ = lower_.cwiseMin(xy);
     upper_ = upper_.cwiseMax(xy);
-    const int64_t col = static_cast<int64_t>(std::floor(xy.x() / tile_size));
-    const int64_t row = static_cast<int64_t>(std::floor(xy.y() / tile_size));
-    tiles_[key(col, row)].push_back(static_cast<int32_t>(i));
+    tiles_[key(cellOf(map.points[i]))].push_back(static_cast<int32_t>(i));
   }
 }
 
-uint64_t MapTiles::key(int64_t col, int64_t row) {
-  return (static_cast<uint64_t>(col) << 32) ^ (static_cast<uint64_t>(row) & 0xFFFFFFFFu);
+uint64_t MapTiles::key(const Cell& cell) {
+  return (static_cast<uint64_t>(cell.col) << 32) ^ (static_cast<uint64_t>(cell.row) & 0xFFFFFFFFu);
+}
+
+MapTiles::Cell MapTiles::cellOf(const Vec3f& point) const {
+  return {static_cast<int64_t>(std::floor(point.x() / tile_size_)),
+          static_cast<int64_t>(std::floor(point.y() / tile_size_))};
+}
+
+const std::vector<int32_t>* MapTiles::pointsIn(const Cell& cell) const {
+  const auto found = tiles_.find(key(cell));
+  return found == tiles_.end() ? nullptr : &found->second;
 }
 
 void MapTiles::pointsNear(const Eigen::Vector3d& center, double radius, std::vector<int32_t>& out) const {
@@ -150,16 +158,16 @@ void MapTiles::pointsNear(const Eigen::Vector3d& center, double radius, std::vec
   const double radius_squared = radius * radius;
   for (int64_t row = first_row; row <= last_row; ++row) {
     for (int64_t col = first_col; col <= last_col; ++col) {
-      const auto found = tiles_.find(key(col, row));
-      if (found == tiles_.end()) continue;
+      const std::vector<int32_t>* points = pointsIn({col, row});
+      if (points == nullptr) continue;
       // A tile wholly inside the disc needs no test per point.
       const double far_x = std::max(std::abs(col * tile_size_ - center.x()), std::abs((col + 1) * tile_size_ - center.x()));
       const double far_y = std::max(std::abs(row * tile_size_ - center.y()), std::abs((row + 1) * tile_size_ - center.y()));
       if (far_x * far_x + far_y * far_y <= radius_squared) {
-        out.insert(out.end(), found->second.begin(), found->second.end());
+        out.insert(out.end(), points->begin(), points->end());
         continue;
       }
-      for (int32_t point : found->second) {
+      for (int32_t point : *points) {
         const Eigen::Vector2d offset = map_.points[point].head<2>().cast<double>() - center.head<2>();
         if (offset.squaredNorm() <= radius_squared) out.push_back(point);
       }
