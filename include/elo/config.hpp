@@ -208,6 +208,10 @@ struct LocalizationConfig {
   double search_yaw_deg = 15.0;
   double search_yaw_step_deg = 5.0;
   int search_refined = 6;        // best-scored candidates registered to convergence
+  // A search's winner must stand out: a refined candidate that converged elsewhere (half a search step or
+  // yaw step away) and is acceptable too refuses the search when its inlier share comes within this of
+  // the winner's (a repeated or featureless stretch of the map).
+  double search_margin = 0.05;
 };
 
 struct Config {

@@ -221,6 +221,8 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("localization.search_yaw_step_deg", c.localization.search_yaw_step_deg, "deg between the search's yaws"),
       bindField("localization.search_refined", c.localization.search_refined,
                 "best-scored search candidates registered to convergence"),
+      bindField("localization.search_margin", c.localization.search_margin,
+                "inlier share by which a search's winner must beat a candidate that converged elsewhere"),
   };
 }
 
@@ -246,6 +248,7 @@ void validateLocalization(const LocalizationConfig& l) {
   require(l.search_yaw_deg >= 0.0 && l.search_yaw_deg <= 180.0, "localization.search_yaw_deg", "must lie in [0, 180]");
   require(l.search_yaw_step_deg > 0.0, "localization.search_yaw_step_deg", "must be positive");
   require(l.search_refined >= 1, "localization.search_refined", "must be at least 1");
+  require(l.search_margin >= 0.0, "localization.search_margin", "must not be negative");
 }
 
 }  // namespace

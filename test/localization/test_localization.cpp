@@ -257,5 +257,56 @@ TEST_F(Localization, AGpuHoldsOnlyThePartOfTheMapNearTheDrive) {
 #endif
 }
 
+#ifndef ELO_LOCALIZATION_LONG
+// A tunnel, mapped by one drive and searched from another's scans. On the open approach the search from
+// a hint 2 m and 10 degrees off is taken; 100 m inside, where nothing varies along the axis, the winner
+// is any pose along it (the candidates converge metres apart with the same fit), and the search is
+// refused, from the true pose too: by the degeneracy of the map match, and, with that analysis off, by
+// the rival candidates that fit as well. The pose never jumps along the tunnel.
+TEST(LocalizationInATunnel, ASearchIsRefusedWhereTheMapLeavesTheAxisFree) {
+  const SharedWorld world(sim::WorldFamily::tunnel, sim::TrajectoryKind::straight, 22.0, 3);
+  const Config mapping_config = sensorConfig("hdl64");
+  const Drive mapping(world, mapping_config, DrivePlan{0.0, 0.0, 11, 1});
+  const auto map = std::make_shared<MapCloud>(mapOfDrive(mapping, mapping.frameCount(), 2, kMapVoxel,
+                                                         mapping_config.localization.normal_radius));
+  const Drive drive(world, mapping_config, DrivePlan{1.0, 0.8, 23, 2});
+  const auto firstFrameBeyond = [&drive](double x) {
+    int frame = 0;
+    while (frame < drive.frameCount() && drive.pose(frame).translation().x() < x) ++frame;
+    return frame;
+  };
+  // The first scan searched from `hint`, with the degeneracy analysis at `threshold`.
+  const auto searchedFrom = [&](int frame, const Eigen::Isometry3d& hint, double threshold) {
+    Config config = sensorConfig("hdl64");
+    config.registration.degeneracy_threshold = threshold;
+    Odometry odometry(config);
+    Localizer localizer(odometry, map);
+    localizer.setInitialPose(hint);
+    return localizer.update(odometry.process(drive.scan(frame)));
+  };
+  const double threshold = mapping_config.registration.degeneracy_threshold;
+
+  const int approach = firstFrameBeyond(30.0);
+  const LocalizationResult outside = searchedFrom(approach, offsetBy(drive.pose(approach), 2.0, 10.0), threshold);
+  ASSERT_TRUE(outside.matched) << outside.refusal;
+  EXPECT_LT((outside.pose.translation() - drive.pose(approach).translation()).norm(), 0.1);
+
+  const int inside = firstFrameBeyond(200.0);
+  ASSERT_LT(inside, drive.frameCount());
+  for (const double along : {0.0, 2.0}) {
+    const Eigen::Isometry3d hint = drive.pose(inside) * Eigen::Translation3d(along, 0.0, 0.0);
+    const LocalizationResult degenerate = searchedFrom(inside, hint, threshold);
+    EXPECT_FALSE(degenerate.matched) << "hint " << along << " m along: error "
+                                     << (degenerate.pose.translation() - drive.pose(inside).translation()).norm();
+    EXPECT_NE(degenerate.refusal.find("does not fix the pose along x"), std::string::npos) << degenerate.refusal;
+    EXPECT_EQ(degenerate.state, LocalizationState::waiting_for_pose);
+
+    const LocalizationResult rivalled = searchedFrom(inside, hint, 0.0);
+    EXPECT_FALSE(rivalled.matched) << "hint " << along << " m along, no degeneracy analysis";
+    EXPECT_NE(rivalled.refusal.find("fits the map about as well"), std::string::npos) << rivalled.refusal;
+  }
+}
+#endif
+
 }  // namespace
 }  // namespace elo::test

@@ -106,8 +106,16 @@ class Localizer {
   // Registers the scan against the rendered map from `rendered_from_scan`.
   Match registerAgainstMap(const Eigen::Isometry3d& rendered, const Eigen::Isometry3d& rendered_from_scan,
                            bool informed, int max_iterations);
-  // The search around `hint` for the scan's reference frame; the best match, acceptable or not.
-  std::optional<Match> search(const PoseHint& hint, LocalizationResult& result);
+  // What a search found: its winner, registered again where it stands, and a rival: the best acceptable
+  // candidate that converged elsewhere and fits about as well (localization.search_margin), if any.
+  struct SearchOutcome {
+    Match best;
+    std::optional<Match> rival;
+  };
+  // The search around `hint` for the scan's reference frame; nullopt where the map has nothing there.
+  std::optional<SearchOutcome> search(const PoseHint& hint, LocalizationResult& result);
+  // Whether `rival`, refined from the same rendering as `winner`, is another place that fits about as well.
+  bool rivals(const Match& rival, const Match& winner) const;
   void track(LocalizationResult& result);
   void relocalize(const PoseHint& hint, LocalizationResult& result);
   void accept(const Match& match, LocalizationResult& result);

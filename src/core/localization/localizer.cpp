@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "core/common/map_render.hpp"
 #include "core/elapsed_time.hpp"
+#include "elo/degeneracy.hpp"
 #include "elo/registration.hpp"
 
 namespace elo {
@@ -138,7 +140,7 @@ Localizer::Match Localizer::registerAgainstMap(const Eigen::Isometry3d& rendered
   return {rendered * result.model_from_scan, healthOf(result), result.hessian};
 }
 
-std::optional<Localizer::Match> Localizer::search(const PoseHint& hint, LocalizationResult& result) {
+std::optional<Localizer::SearchOutcome> Localizer::search(const PoseHint& hint, LocalizationResult& result) {
   result.searched = true;
   PoseHint around = hint;
   if (!std::isfinite(around.map_from_sensor.translation().z())) {
@@ -156,16 +158,32 @@ std::optional<Localizer::Match> Localizer::search(const PoseHint& hint, Localiza
   const size_t refined = std::min<size_t>(scored.size(), static_cast<size_t>(config_.localization.search_refined));
   std::partial_sort(scored.begin(), scored.begin() + refined, scored.end(),
                     [](const Match& a, const Match& b) { return fitsBetter(a.health, b.health); });
-  std::optional<Match> best;
+  std::vector<Match> converged;
   for (size_t i = 0; i < refined; ++i) {
     const Eigen::Isometry3d from = around.map_from_sensor.inverse() * scored[i].map_from_sensor;
-    Match match = registerAgainstMap(around.map_from_sensor, from, false, config_.registration.max_iterations);
-    if (!best || fitsBetter(match.health, best->health)) best = match;
+    converged.push_back(registerAgainstMap(around.map_from_sensor, from, false, config_.registration.max_iterations));
+  }
+  const auto fitter = [](const Match& a, const Match& b) { return fitsBetter(a.health, b.health); };
+  const Match& winner = *std::min_element(converged.begin(), converged.end(), fitter);
+  SearchOutcome outcome;
+  for (const Match& match : converged) {
+    if (rivals(match, winner) && (!outcome.rival || fitter(match, *outcome.rival))) outcome.rival = match;
   }
   // The winner registered once more against the map rendered where it stands, as tracking will.
-  render(best->map_from_sensor, result);
-  return registerAgainstMap(best->map_from_sensor, Eigen::Isometry3d::Identity(), false,
-                            config_.registration.max_iterations);
+  render(winner.map_from_sensor, result);
+  outcome.best = registerAgainstMap(winner.map_from_sensor, Eigen::Isometry3d::Identity(), false,
+                                    config_.registration.max_iterations);
+  return outcome;
+}
+
+bool Localizer::rivals(const Match& rival, const Match& winner) const {
+  const LocalizationConfig& config = config_.localization;
+  const Eigen::Isometry3d apart = winner.map_from_sensor.inverse() * rival.map_from_sensor;
+  const double yaw_apart_deg = Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI;
+  const bool elsewhere =
+      apart.translation().norm() > 0.5 * config.search_step || yaw_apart_deg > 0.5 * config.search_yaw_step_deg;
+  return elsewhere && rival.health.acceptable(config) &&
+         rival.health.inlier_share > winner.health.inlier_share - config.search_margin;
 }
 
 void Localizer::accept(const Match& match, LocalizationResult& result) {
@@ -214,12 +232,29 @@ void Localizer::track(LocalizationResult& result) {
 }
 
 void Localizer::relocalize(const PoseHint& hint, LocalizationResult& result) {
-  const std::optional<Match> best = search(hint, result);
-  result.attempted = best.has_value();
-  if (!best) return refuse("no map around the hint", result);
-  result.health = best->health;
-  if (!best->health.acceptable(config_.localization)) return refuse("no pose around the hint fits the map", result);
-  accept(*best, result);
+  const std::optional<SearchOutcome> found = search(hint, result);
+  result.attempted = found.has_value();
+  if (!found) return refuse("no map around the hint", result);
+  const Match& best = found->best;
+  result.health = best.health;
+  if (!best.health.acceptable(config_.localization)) return refuse("no pose around the hint fits the map", result);
+  // Where the map leaves a direction free (a tunnel, a featureless road), the search's winner is any of the
+  // poses along it: the hint cannot be checked there.
+  const std::optional<Degeneracy> degeneracy =
+      analyseDegeneracy(best.hessian, config_.registration.degeneracy_threshold);
+  if (degeneracy && degeneracy->any()) {
+    return refuse("the map here does not fix the pose along " + degeneracy->describe() +
+                      ": give a pose where it does",
+                  result);
+  }
+  if (found->rival) {
+    const Eigen::Isometry3d apart = best.map_from_sensor.inverse() * found->rival->map_from_sensor;
+    char why[160];
+    std::snprintf(why, sizeof why, "another pose %.1f m and %.0f deg away fits the map about as well: give a closer pose",
+                  apart.translation().norm(), Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI);
+    return refuse(why, result);
+  }
+  accept(best, result);
   ++relocalized_;
 }
 
