@@ -40,6 +40,16 @@ bool fitsBetter(const MapMatchHealth& a, const MapMatchHealth& b) {
   return a.rms < b.rms;
 }
 
+// How far pose `b` lies from pose `a`: metres, and degrees of rotation.
+struct PoseGap {
+  double metres;
+  double degrees;
+};
+PoseGap gapBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  const Eigen::Isometry3d apart = a.inverse() * b;
+  return {apart.translation().norm(), Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI};
+}
+
 // The offsets the search tries around its hint, in the hint's frame: positions on a square grid within
 // `radius`, each at every yaw step within `yaw_deg`; the hint itself first.
 std::vector<Eigen::Isometry3d> searchOffsets(const PoseHint& hint, const LocalizationConfig& config) {
@@ -178,10 +188,8 @@ std::optional<Localizer::SearchOutcome> Localizer::search(const PoseHint& hint, 
 
 bool Localizer::rivals(const Match& rival, const Match& winner) const {
   const LocalizationConfig& config = config_.localization;
-  const Eigen::Isometry3d apart = winner.map_from_sensor.inverse() * rival.map_from_sensor;
-  const double yaw_apart_deg = Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI;
-  const bool elsewhere =
-      apart.translation().norm() > 0.5 * config.search_step || yaw_apart_deg > 0.5 * config.search_yaw_step_deg;
+  const PoseGap gap = gapBetween(winner.map_from_sensor, rival.map_from_sensor);
+  const bool elsewhere = gap.metres > 0.5 * config.search_step || gap.degrees > 0.5 * config.search_yaw_step_deg;
   return elsewhere && rival.health.acceptable(config) &&
          rival.health.inlier_share > winner.health.inlier_share - config.search_margin;
 }
@@ -248,10 +256,10 @@ void Localizer::relocalize(const PoseHint& hint, LocalizationResult& result) {
                   result);
   }
   if (found->rival) {
-    const Eigen::Isometry3d apart = best.map_from_sensor.inverse() * found->rival->map_from_sensor;
+    const PoseGap gap = gapBetween(best.map_from_sensor, found->rival->map_from_sensor);
     char why[160];
     std::snprintf(why, sizeof why, "another pose %.1f m and %.0f deg away fits the map about as well: give a closer pose",
-                  apart.translation().norm(), Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI);
+                  gap.metres, gap.degrees);
     return refuse(why, result);
   }
   accept(best, result);
