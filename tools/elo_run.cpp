@@ -405,7 +405,11 @@ class ScanLoop {
       if (i + 1 < played.size()) next = readPlayed(played[i + 1]);
       const elo::FrameResult result = processScan(played[i].index, current);
       // A skipped scan repeats the last pose, keeping lines aligned.
-      trajectory.poses.push_back(localizer_ ? localize(played[i].index, result) : result.pose);
+      if (localizer_) {
+        waiting_poses_.add(localize(played[i].index, result), trajectory.poses);
+      } else {
+        trajectory.poses.push_back(result.pose);
+      }
       trajectory.stamps.push_back(played[i].stamp);
       if (timing_.is_open()) writeTimingRow(timing_, i, played[i].stamp, result);
       if (progress) showProgress(i + 1, played.size());
@@ -414,10 +418,11 @@ class ScanLoop {
 
   const Report& report() const { return report_; }
   const elo::tools::LocalizationReport& localizationReport() const { return localization_report_; }
+  const elo::tools::PosesBeforeTheFirstMatch& posesBeforeTheFirstMatch() const { return waiting_poses_; }
   size_t nonFinitePoints() const { return non_finite_points_; }
 
  private:
-  Eigen::Isometry3d localize(size_t scan, const elo::FrameResult& result) {
+  elo::LocalizationResult localize(size_t scan, const elo::FrameResult& result) {
     const elo::LocalizationState before = localizer_->state();
     const elo::LocalizationResult localized = localizer_->update(result);
     localization_report_.add(localized, result.times.total);
@@ -425,7 +430,7 @@ class ScanLoop {
       std::fprintf(stderr, "\nscan %zu: localization %s%s%s\n", scan, elo::stateName(localized.state),
                    localized.refusal.empty() ? "" : ": ", localized.refusal.c_str());
     }
-    return localized.pose;
+    return localized;
   }
 
   // Reads the scan, stamped as played, and prefetches it unless --no-prefetch.
@@ -483,6 +488,7 @@ class ScanLoop {
   std::ofstream timing_;
   Report report_;
   elo::tools::LocalizationReport localization_report_;
+  elo::tools::PosesBeforeTheFirstMatch waiting_poses_;
   size_t non_finite_points_ = 0;
   std::set<std::string> warned_;
 };
@@ -527,6 +533,7 @@ int run(const Options& options) {
     loop.run(played, trajectory);
   } catch (const std::exception&) {
     writeTrajectory(options, *source, trajectory);
+    if (localizer) loop.posesBeforeTheFirstMatch().print();
     std::fprintf(stderr, "\nelo_run: stopped after %zu of %zu scans; their poses are in %s\n", trajectory.poses.size(),
                  played.size(), options.output.c_str());
     if (map) writeMapAfterFailure(*map);
@@ -542,7 +549,10 @@ int run(const Options& options) {
     std::printf("map cost a processed scan (CPU time): %.2f ms copying points (odometry's thread), %.2f ms adding "
                 "them (map's thread); the pipeline took %.1f ms (wall)\n", copy_ms, add_ms, pipeline_ms);
   }
-  if (localizer) loop.localizationReport().print(*localizer);
+  if (localizer) {
+    loop.localizationReport().print(*localizer);
+    loop.posesBeforeTheFirstMatch().print();
+  }
   return 0;
 }
 

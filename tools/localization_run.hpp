@@ -46,16 +46,49 @@ inline std::shared_ptr<const MapCloud> loadMap(const std::string& path, const Co
   return std::make_shared<const MapCloud>(std::move(map));
 }
 
+// The poses written before the first accepted match are the odometry's, there being no pose in the map
+// yet; that match's correction places them in the map, so that the output is in the map frame throughout.
+class PosesBeforeTheFirstMatch {
+ public:
+  // Appends `result`'s pose to `poses`, and places the waiting ones once a match is accepted.
+  void add(const LocalizationResult& result, std::vector<Eigen::Isometry3d>& poses) {
+    poses.push_back(result.pose);
+    if (result.state == LocalizationState::waiting_for_pose) {
+      waiting_.push_back(poses.size() - 1);
+      return;
+    }
+    if (!result.matched || waiting_.empty()) return;
+    for (size_t line : waiting_) poses[line] = result.map_correction * poses[line];
+    placed_ = waiting_.size();
+    waiting_.clear();
+  }
+  // Says which poses were placed after the fact, or are not in the map frame at all.
+  void print() const {
+    if (placed_ > 0) {
+      std::printf("localization: the %zu scans before the first accepted match were placed in the map by it\n", placed_);
+    }
+    if (!waiting_.empty()) {
+      std::fprintf(stderr, "warning: no pose in the map was found: the %zu poses written while waiting for one are "
+                   "the odometry's, in the frame of its first scan\n", waiting_.size());
+    }
+  }
+
+ private:
+  std::vector<size_t> waiting_;  // lines of `poses` written while waiting for a pose
+  size_t placed_ = 0;
+};
+
 // Counts what the localizer did over the run.
 class LocalizationReport {
  public:
   // `odometry_ms`: the odometry's time on the same scan (FrameResult::times.total).
   void add(const LocalizationResult& result, double odometry_ms) {
     if (result.attempted) ++attempted_;
-    if (result.searched) ++searches_;
     if (result.searched) {
+      ++searches_;
       search_milliseconds_ += result.milliseconds;
-    } else {
+    } else if (result.attempted || result.state == LocalizationState::tracking) {
+      // A tracked scan (one waiting for a pose, or lost between searches, does no map match).
       milliseconds_ += result.milliseconds;
       odometry_milliseconds_ += odometry_ms;
       ++tracked_scans_;
@@ -80,7 +113,7 @@ class LocalizationReport {
     }
     const double total = odometry_milliseconds_ + milliseconds_;
     if (total > 0.0) {
-      std::printf("FPS with localization: %.1f (odometry and map match, scans without a search)\n",
+      std::printf("FPS with localization: %.1f (odometry and map match, over the tracked scans)\n",
                   1000.0 * tracked_scans_ / total);
     }
   }
@@ -88,8 +121,8 @@ class LocalizationReport {
  private:
   size_t attempted_ = 0;
   size_t searches_ = 0;
-  double milliseconds_ = 0.0;  // the localization's, over the scans without a search
-  double odometry_milliseconds_ = 0.0;  // over the scans without a search
+  double milliseconds_ = 0.0;  // the localization's, over the tracked scans
+  double odometry_milliseconds_ = 0.0;  // over the tracked scans
   double search_milliseconds_ = 0.0;
   size_t tracked_scans_ = 0;
   double inlier_share_ = 0.0;

@@ -200,7 +200,9 @@ struct LocalizationConfig {
   double min_inlier_share = 0.5;
   double max_rms = 0.12;
   double max_correction = 1.0;   // m: a tracked match moving the pose further than this is refused
-  int lost_after = 10;           // refused or failed matches in a row that declare the vehicle lost
+  // Refused or failed matches in a row that declare the vehicle lost; while lost, or while a refused hint
+  // is carried, the scans from one search to the next.
+  int lost_after = 10;
   // The initial-pose search around a hint: positions within search_radius (m) every search_step (m),
   // yaws within search_yaw_deg either side every search_yaw_step_deg.
   double search_radius = 2.5;

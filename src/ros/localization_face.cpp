@@ -160,7 +160,10 @@ void LocalizationFace::report(diagnostic_updater::DiagnosticStatusWrapper& statu
       status.summary(DiagnosticStatus::OK, "tracking");
       break;
     case elo::LocalizationState::waiting_for_pose:
-      status.summary(DiagnosticStatus::WARN, "waiting for an initial pose (/initialpose or ~initial_pose)");
+      status.summary(DiagnosticStatus::WARN, last_.hint_carried
+                                                 ? "waiting: the pose given was refused (see last refusal); searched "
+                                                   "around again as the vehicle moves, or give another"
+                                                 : "waiting for an initial pose (/initialpose or ~initial_pose)");
       break;
     case elo::LocalizationState::lost:
       status.summary(DiagnosticStatus::ERROR, "lost: map matches refused; give a pose (/initialpose)");

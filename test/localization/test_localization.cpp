@@ -163,31 +163,154 @@ TEST_F(Localization, Vlp16LocalizesInTheHdl64Map) {
   EXPECT_GT(matched, run.results.size() * 3 / 4);
 }
 
-// A hint far outside the search is refused scan after scan: the pose never jumps to a bad match.
+// A hint far outside the search is refused, and searched around again every lost_after scans as the
+// odometry carries it: the pose never jumps to a bad match.
 TEST_F(Localization, AWrongHintIsNeverAccepted) {
   const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
   Odometry odometry(sensorConfig("hdl64"));
+  const int lost_after = odometry.config().localization.lost_after;
   Localizer localizer(odometry, map_);
-  for (int frame = 0; frame < 3; ++frame) {
-    localizer.setInitialPose(offsetBy(drive.pose(frame), 25.0, 0.0));
+  localizer.setInitialPose(offsetBy(drive.pose(0), 25.0, 0.0));
+  int searches = 0;
+  for (int frame = 0; frame <= 3 * lost_after; ++frame) {
     const LocalizationResult result = localizer.update(odometry.process(drive.scan(frame)));
-    EXPECT_TRUE(result.searched);
+    EXPECT_EQ(result.searched, frame % lost_after == 0) << "scan " << frame;
+    searches += result.searched ? 1 : 0;
     EXPECT_FALSE(result.matched) << "scan " << frame << ": inlier share " << result.health.inlier_share << ", RMS "
                                  << result.health.rms;
     EXPECT_EQ(result.state, LocalizationState::waiting_for_pose);
+    EXPECT_TRUE(result.hint_carried);
   }
+  EXPECT_EQ(searches, 4);
+}
+
+// The map's points that lie more than `metres` ahead of `pose` (along its x axis): a map whose mapping
+// drive began further along the road.
+std::shared_ptr<MapCloud> mapAheadOf(const MapCloud& map, const Eigen::Isometry3d& pose, double metres) {
+  const Eigen::Vector3f origin = pose.translation().cast<float>();
+  const Eigen::Vector3f forward = pose.rotation().col(0).cast<float>();
+  auto ahead = std::make_shared<MapCloud>();
+  for (size_t i = 0; i < map.size(); ++i) {
+    if ((map.points[i] - origin).dot(forward) <= metres) continue;
+    ahead->points.push_back(map.points[i]);
+    ahead->normals.push_back(map.normals[i]);
+    if (!map.intensity.empty()) ahead->intensity.push_back(map.intensity[i]);
+  }
+  return ahead;
+}
+
+// A drive that begins short of the mapped road, given its true pose at the first scan (as from GPS): the
+// search there is refused, the scan seeing mostly what the map lacks, and the hint is not dropped. The
+// odometry carries it, through a restart of the odometry too (time going backwards), and the search
+// around it runs every lost_after scans until, the vehicle on the mapped road, one is taken; from then
+// on the drive tracks.
+TEST_F(Localization, AHintGivenBeforeTheMappedRoadIsTakenOnReachingIt) {
+  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
+  const std::shared_ptr<MapCloud> ahead = mapAheadOf(*map_, drive.pose(0), 10.0);
+  Odometry odometry(sensorConfig("hdl64"));
+  const int lost_after = odometry.config().localization.lost_after;
+  Localizer localizer(odometry, ahead);
+  localizer.setInitialPose(drive.pose(0));
+  constexpr int kRestartAt = 25;         // from this scan on the stamps are 5 s earlier: the odometry restarts
+  constexpr int kFrames = 50;
+  int taken = -1;
+  std::vector<double> errors;
+  for (int frame = 0; frame < std::min(framesOf(drive), kFrames); ++frame) {
+    PointCloud scan = drive.scan(frame);
+    if (frame >= kRestartAt) scan.stamp -= 5.0;
+    const FrameResult odometry_result = odometry.process(scan);
+    EXPECT_EQ(odometry_result.reset, frame == kRestartAt);
+    const LocalizationResult result = localizer.update(odometry_result);
+    const double error = (result.pose.translation() - drive.pose(frame).translation()).norm();
+    if (taken < 0) {
+      // Until one is taken, the search around the carried hint runs every lost_after scans.
+      EXPECT_EQ(result.searched, frame % lost_after == 0) << "scan " << frame;
+      if (result.searched && !result.matched) {
+        EXPECT_NE(result.refusal.find("no pose around the hint fits"), std::string::npos) << result.refusal;
+      }
+      if (result.matched) {
+        taken = frame;
+        EXPECT_LT(error, 0.1) << "taken at scan " << frame;
+      } else {
+        EXPECT_EQ(result.state, LocalizationState::waiting_for_pose) << "scan " << frame;
+        EXPECT_TRUE(result.hint_carried) << "scan " << frame;
+      }
+      continue;
+    }
+    EXPECT_EQ(result.state, LocalizationState::tracking) << "scan " << frame;
+    EXPECT_FALSE(result.hint_carried);
+    errors.push_back(error);
+  }
+  ASSERT_GT(taken, 0) << "the hint was never taken (the first search should be refused: the map starts 10 m ahead)";
+  ASSERT_FALSE(errors.empty()) << "taken at the last scan";
+  double sum = 0.0;
+  for (double error : errors) sum += error * error;
+  const double rmse = std::sqrt(sum / errors.size());
+  std::printf("a hint given 10 m short of the map: taken at scan %d (searched every %d scans; the odometry restarted at "
+              "scan %d), position RMSE %.3f m over the next %zu scans\n",
+              taken, lost_after, kRestartAt, rmse, errors.size());
+  EXPECT_LE(rmse, 0.10);
+}
+
+// The other drive (HDL-64E) localized from its true first pose over its first `scans` scans.
+struct TrackedDrive {
+  TrackedDrive(const SharedWorld& world, std::shared_ptr<MapCloud> map, int scans)
+      : drive(world, sensorConfig("hdl64"), otherDrive()), odometry(sensorConfig("hdl64")), localizer(odometry, map) {
+    localizer.setInitialPose(drive.pose(0));
+    for (int frame = 0; frame < scans; ++frame) localizer.update(odometry.process(drive.scan(frame)));
+  }
+  Drive drive;
+  Odometry odometry;
+  Localizer localizer;
+};
+
+// Time goes backwards while tracking, on a scan the odometry then skips (ten points: too few), and the
+// odometry restarts at the identity. The localizer puts the new frame where the last scan was, searches
+// around it at the next scan and tracks on; the pose in the map does not jump.
+TEST_F(Localization, AnOdometryRestartOnASkippedScanKeepsThePoseInTheMap) {
+  constexpr int kRestartAt = 15;
+  TrackedDrive tracked(*world_, map_, kRestartAt);
+  ASSERT_EQ(tracked.localizer.state(), LocalizationState::tracking);
+  const Drive& drive = tracked.drive;
+  Odometry& odometry = tracked.odometry;
+  Localizer& localizer = tracked.localizer;
+
+  PointCloud stub = drive.scan(kRestartAt);
+  stub.points.resize(10);
+  stub.intensity.resize(std::min<size_t>(stub.intensity.size(), 10));
+  stub.ring.resize(std::min<size_t>(stub.ring.size(), 10));
+  stub.time.resize(std::min<size_t>(stub.time.size(), 10));
+  stub.stamp -= 5.0;
+  const FrameResult skipped = odometry.process(stub);
+  ASSERT_TRUE(skipped.reset && !skipped.processed) << skipped.skip_reason;
+  const LocalizationResult held = localizer.update(skipped);
+  EXPECT_LT((held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm(), 0.1)
+      << "the skipped scan keeps the last pose in the map";
+
+  double worst = 0.0;
+  for (int frame = kRestartAt + 1; frame < kRestartAt + 12; ++frame) {
+    PointCloud scan = drive.scan(frame);
+    scan.stamp -= 5.0;
+    const LocalizationResult result = localizer.update(odometry.process(scan));
+    EXPECT_EQ(result.searched, frame == kRestartAt + 1) << "scan " << frame;
+    EXPECT_TRUE(result.matched) << "scan " << frame << ": " << result.refusal;
+    worst = std::max(worst, (result.pose.translation() - drive.pose(frame).translation()).norm());
+  }
+  std::printf("time backwards on a skipped scan while tracking: the pose kept %.3f m from the last scan's truth; "
+              "searched at the next scan, worst error over the next 11 scans %.3f m\n",
+              (held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm(), worst);
+  EXPECT_LT(worst, 0.1);
 }
 
 // The vehicle is carried 50 m along the road between two scans. The localizer refuses the matches at the
 // old place, declares itself lost, and relocalizes from a hint 4 m and 25 degrees off the truth.
 TEST_F(Localization, AKidnappedVehicleIsDetectedAndRelocalizedFromAHint) {
-  const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
-  Odometry odometry(sensorConfig("hdl64"));
-  Localizer localizer(odometry, map_);
-  localizer.setInitialPose(drive.pose(0));
   constexpr int kBefore = 15;
-  for (int frame = 0; frame < kBefore; ++frame) localizer.update(odometry.process(drive.scan(frame)));
-  ASSERT_EQ(localizer.state(), LocalizationState::tracking);
+  TrackedDrive tracked(*world_, map_, kBefore);
+  ASSERT_EQ(tracked.localizer.state(), LocalizationState::tracking);
+  const Drive& drive = tracked.drive;
+  Odometry& odometry = tracked.odometry;
+  Localizer& localizer = tracked.localizer;
   int landing = kBefore;
   while (landing < drive.frameCount() &&
          (drive.pose(landing).translation() - drive.pose(kBefore - 1).translation()).norm() < 50.0) {

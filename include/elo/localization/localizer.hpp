@@ -16,7 +16,7 @@
 namespace elo {
 
 enum class LocalizationState {
-  waiting_for_pose,  // no pose in the map yet: give one (setInitialPose())
+  waiting_for_pose,  // no pose in the map yet: give one (setInitialPose()); a refused one is searched again
   tracking,          // matches are accepted; map -> odom follows them
   lost,              // lost_after matches in a row refused: the pose is the odometry's since the last accepted one
 };
@@ -48,10 +48,17 @@ struct LocalizationResult {
   bool attempted = false;    // a map match was tried on this scan
   bool matched = false;      // and accepted: map -> odom was corrected by it
   bool searched = false;     // an initial-pose search ran on this scan
+  // Not tracking, with a hint the odometry carries: a search around it runs every lost_after scans.
+  bool hint_carried = false;
   std::string refusal;       // why a tried match was not accepted
   MapMatchHealth health;     // of the match tried on this scan
   Eigen::Isometry3d map_from_odom = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the sensor in the map at the scan's stamp
+  // The sensor in the map at the scan's stamp. While waiting for a pose, the odometry's (from its first
+  // scan, carried across its restarts): the first accepted match's map_correction places those in the map.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  // How this scan's accepted match moved map -> odom: a pose reported before it, P, lies at
+  // map_correction * P in the map as corrected (the identity when no match was accepted).
+  Eigen::Isometry3d map_correction = Eigen::Isometry3d::Identity();
   // Of `pose`, (x y z, rotation about x y z) in the sensor frame, from the last accepted match's
   // Hessian and residuals, grown by nothing between matches (a figure of the fit, not of drift).
   Matrix6d covariance = Matrix6d::Identity();
@@ -71,7 +78,10 @@ class Localizer {
 
   // The sensor's pose in the map near the next scan: that scan searches around it (localization.search_*
   // unless `radius` / `yaw_deg` are given) and takes the best match only if it is acceptable. A hint's z
-  // that is NaN (rviz's 2D Pose Estimate has none) is taken from the map's ground under it.
+  // that is NaN (rviz's 2D Pose Estimate has none) is taken from the map's ground under it. A refused hint
+  // is not dropped while no match is being accepted: the odometry carries it, and the search around it
+  // runs again every localization.lost_after scans until one is taken or another hint replaces it (a
+  // pose given in a tunnel, or before the vehicle enters the map, is taken where the map fixes it).
   void setInitialPose(const Eigen::Isometry3d& map_from_sensor, std::optional<double> radius = std::nullopt,
                       std::optional<double> yaw_deg = std::nullopt);
 
@@ -80,7 +90,8 @@ class Localizer {
   LocalizationResult update(const FrameResult& frame);
 
   // The odometry started a new trajectory at the identity (Odometry::reset()): map -> odom no longer
-  // holds. The next scan searches around the last pose in the map, the vehicle having moved little.
+  // holds. The new frame is put where the last scan was in the map, the vehicle having moved little, and
+  // (once a pose was found) the next scan searches around it.
   void odometryRestarted();
 
   LocalizationState state() const { return state_; }
@@ -118,6 +129,18 @@ class Localizer {
   bool rivals(const Match& rival, const Match& winner) const;
   void track(LocalizationResult& result);
   void relocalize(const PoseHint& hint, LocalizationResult& result);
+  // A hint the odometry carries between searches: its map -> odom, and how wide it is searched.
+  struct CarriedHint {
+    Eigen::Isometry3d map_from_odom;
+    double radius;
+    double yaw_deg;
+  };
+  // `hint`, given for the scan just processed, carried on by the odometry.
+  CarriedHint carried(const PoseHint& hint) const;
+  // The carried hint where the odometry puts the scan just processed.
+  PoseHint carriedHintNow() const;
+  // Whether this scan searches around the carried hint: every lost_after scans while not tracking.
+  bool searchDue() const;
   void accept(const Match& match, LocalizationResult& result);
   void refuse(const std::string& why, LocalizationResult& result);
 
@@ -129,8 +152,9 @@ class Localizer {
   LocalizationState state_ = LocalizationState::waiting_for_pose;
   Eigen::Isometry3d map_from_odom_ = Eigen::Isometry3d::Identity();
   std::optional<PoseHint> pending_hint_;
-  Eigen::Isometry3d last_map_pose_ = Eigen::Isometry3d::Identity();  // at the last processed scan
-  bool has_map_pose_ = false;
+  // While not tracking: the refused hint, or, once lost, the pose the odometry carries from the last match.
+  std::optional<CarriedHint> carried_hint_;
+  Eigen::Isometry3d last_odometry_pose_ = Eigen::Isometry3d::Identity();  // the last processed scan's
   Matrix6d covariance_ = Matrix6d::Identity();
   int refused_in_row_ = 0;
   int scans_since_match_ = 0;

@@ -195,7 +195,9 @@ bool Localizer::rivals(const Match& rival, const Match& winner) const {
 }
 
 void Localizer::accept(const Match& match, LocalizationResult& result) {
+  const Eigen::Isometry3d before = map_from_odom_;
   map_from_odom_ = match.map_from_sensor * odometry_.modelPose().inverse();
+  result.map_correction = map_from_odom_ * before.inverse();
   // (N H)^-1 scaled by the residual variance: H is the fused J^T J normalised by the inlier counts. The
   // registration's twist lies in the frame the map was rendered in, the sensor's: its axes turned into
   // the map's, as a pose's covariance is given.
@@ -207,6 +209,7 @@ void Localizer::accept(const Match& match, LocalizationResult& result) {
   rotate.bottomRightCorner<3, 3>() = match.map_from_sensor.rotation();
   covariance_ = rotate * twist_covariance * rotate.transpose();
   state_ = LocalizationState::tracking;
+  carried_hint_.reset();
   refused_in_row_ = 0;
   scans_since_match_ = 0;
   ++accepted_;
@@ -219,6 +222,9 @@ void Localizer::refuse(const std::string& why, LocalizationResult& result) {
   result.refusal = why;
   if (state_ == LocalizationState::tracking && refused_in_row_ >= config_.localization.lost_after) {
     state_ = LocalizationState::lost;
+    // Searched around from now on: where the odometry puts the vehicle since the last accepted match.
+    const LocalizationConfig& config = config_.localization;
+    carried_hint_ = CarriedHint{map_from_odom_, config.search_radius, config.search_yaw_deg};
   }
 }
 
@@ -239,7 +245,18 @@ void Localizer::track(LocalizationResult& result) {
   accept(match, result);
 }
 
+Localizer::CarriedHint Localizer::carried(const PoseHint& hint) const {
+  // A hint's unknown height (NaN z) stays unknown as it is carried: each search takes it from the map.
+  return {hint.map_from_sensor * odometry_.modelPose().inverse(), hint.radius, hint.yaw_deg};
+}
+
+PoseHint Localizer::carriedHintNow() const {
+  return {carried_hint_->map_from_odom * odometry_.modelPose(), carried_hint_->radius, carried_hint_->yaw_deg};
+}
+
 void Localizer::relocalize(const PoseHint& hint, LocalizationResult& result) {
+  // Until a match is taken, this hint is searched around again as the odometry carries it.
+  if (state_ != LocalizationState::tracking) carried_hint_ = carried(hint);
   const std::optional<SearchOutcome> found = search(hint, result);
   result.attempted = found.has_value();
   if (!found) return refuse("no map around the hint", result);
@@ -267,41 +284,45 @@ void Localizer::relocalize(const PoseHint& hint, LocalizationResult& result) {
 }
 
 void Localizer::odometryRestarted() {
-  if (!has_map_pose_) return;
+  // The odometry started again at the identity: map -> odom, and a carried hint's, now put the new
+  // frame's origin where the last scan was, the vehicle having moved little since (time went backwards).
+  // That is a guess, not a match: the scan searches around it.
+  map_from_odom_ = map_from_odom_ * last_odometry_pose_;
+  if (carried_hint_) carried_hint_->map_from_odom = carried_hint_->map_from_odom * last_odometry_pose_;
+  last_odometry_pose_ = Eigen::Isometry3d::Identity();
+  if (state_ == LocalizationState::waiting_for_pose || pending_hint_) return;
   if (state_ == LocalizationState::tracking) state_ = LocalizationState::lost;
-  if (!pending_hint_) setInitialPose(last_map_pose_);
+  setInitialPose(map_from_odom_);
+}
+
+bool Localizer::searchDue() const {
+  return carried_hint_ && scans_since_match_ % config_.localization.lost_after == 0;
 }
 
 LocalizationResult Localizer::update(const FrameResult& frame) {
   const auto start = Clock::now();
   LocalizationResult result;
+  // A restart is told on the scan that found time going backwards, processed or skipped.
+  if (frame.reset) odometryRestarted();
   if (frame.processed) {
-    // The odometry restarted at the identity: its frame moved, so map -> odom no longer holds. The last
-    // pose in the map is the hint, the vehicle having moved little since (time went backwards).
-    if (frame.reset) odometryRestarted();
     if (pending_hint_) {
       const PoseHint hint = *pending_hint_;
       pending_hint_.reset();
       relocalize(hint, result);
     } else if (state_ == LocalizationState::tracking) {
       track(result);
-    } else if (state_ == LocalizationState::lost && scans_since_match_ % config_.localization.lost_after == 0) {
-      // Lost: now and then, a search around where the odometry puts the vehicle.
-      relocalize({map_from_odom_ * odometry_.modelPose(), config_.localization.search_radius,
-                  config_.localization.search_yaw_deg},
-                 result);
+    } else if (searchDue()) {
+      relocalize(carriedHintNow(), result);
     }
     if (!result.matched) ++scans_since_match_;
+    last_odometry_pose_ = frame.pose;
   }
   result.state = state_;
+  result.hint_carried = carried_hint_.has_value();
   result.map_from_odom = map_from_odom_;
   result.pose = map_from_odom_ * frame.pose;
   result.covariance = covariance_;
   result.scans_since_match = scans_since_match_;
-  if (state_ != LocalizationState::waiting_for_pose) {
-    last_map_pose_ = result.pose;
-    has_map_pose_ = true;
-  }
   result.milliseconds = millisecondsSince(start);
   return result;
 }
