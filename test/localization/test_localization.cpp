@@ -275,13 +275,13 @@ TEST_F(Localization, AnOdometryRestartOnASkippedScanKeepsThePoseInTheMap) {
   Odometry& odometry = tracked.odometry;
   Localizer& localizer = tracked.localizer;
 
-  PointCloud stub = drive.scan(kRestartAt);
-  stub.points.resize(10);
-  stub.intensity.resize(std::min<size_t>(stub.intensity.size(), 10));
-  stub.ring.resize(std::min<size_t>(stub.ring.size(), 10));
-  stub.time.resize(std::min<size_t>(stub.time.size(), 10));
-  stub.stamp -= 5.0;
-  const FrameResult skipped = odometry.process(stub);
+  PointCloud ten_points = drive.scan(kRestartAt);
+  ten_points.points.resize(10);
+  ten_points.intensity.resize(std::min<size_t>(ten_points.intensity.size(), 10));
+  ten_points.ring.resize(std::min<size_t>(ten_points.ring.size(), 10));
+  ten_points.time.resize(std::min<size_t>(ten_points.time.size(), 10));
+  ten_points.stamp -= 5.0;
+  const FrameResult skipped = odometry.process(ten_points);
   ASSERT_TRUE(skipped.reset && !skipped.processed) << skipped.skip_reason;
   const LocalizationResult held = localizer.update(skipped);
   EXPECT_LT((held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm(), 0.1)
