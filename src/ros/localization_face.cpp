@@ -136,6 +136,14 @@ void LocalizationFace::onInitialPose(const geometry_msgs::PoseWithCovarianceStam
 
 bool LocalizationFace::onRelocalize(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   std::lock_guard<std::mutex> lock(odometry_mutex_);
+  // Not tracking: around the hint the odometry carries, at once rather than at its next periodic search.
+  if (const std::optional<elo::PoseHint> carried = localizer_->carriedHint()) {
+    localizer_->setInitialPose(carried->map_from_sensor, carried->radius, carried->yaw_deg);
+    response.success = true;
+    response.message = "the next scan searches around the pose given (or, lost, the last match's), as the odometry "
+                       "carries it";
+    return true;
+  }
   if (localizer_->state() == elo::LocalizationState::waiting_for_pose) {
     response.success = false;
     response.message = "no pose in the map yet: give one (~initial_pose or /initialpose)";

@@ -234,11 +234,21 @@ TEST_F(Localization, AHintGivenBeforeTheMappedRoadIsTakenOnReachingIt) {
       } else {
         EXPECT_EQ(result.state, LocalizationState::waiting_for_pose) << "scan " << frame;
         EXPECT_TRUE(result.hint_carried) << "scan " << frame;
+        // The true first pose, carried by the odometry: where the vehicle is, but for the drift and, from
+        // the restart on, the step the restart did not see (its scan is put where the one before was).
+        const std::optional<PoseHint> carried = localizer.carriedHint();
+        ASSERT_TRUE(carried.has_value()) << "scan " << frame;
+        const double unseen_step = frame >= kRestartAt ? (drive.pose(kRestartAt).translation() -
+                                                          drive.pose(kRestartAt - 1).translation()).norm()
+                                                       : 0.0;
+        EXPECT_LT((carried->map_from_sensor.translation() - drive.pose(frame).translation()).norm(), 0.1 + unseen_step)
+            << "scan " << frame;
       }
       continue;
     }
     EXPECT_EQ(result.state, LocalizationState::tracking) << "scan " << frame;
     EXPECT_FALSE(result.hint_carried);
+    EXPECT_FALSE(localizer.carriedHint().has_value());
     errors.push_back(error);
   }
   ASSERT_GT(taken, 0) << "the hint was never taken (the first search should be refused: the map starts 10 m ahead)";

@@ -4,6 +4,7 @@
 // map -> odom; a "localization" diagnostics status.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "rostest_helpers.hpp"
@@ -50,6 +51,13 @@ TEST(SimulatedLocalization, LocalizesTheBagFromAnInitialPoseOnTheTopic) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(10.0);
   while (initial_pose.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) ros::WallDuration(0.05).sleep();
   ASSERT_GT(initial_pose.getNumSubscribers(), 0u) << "nobody listens on /initialpose";
+  const std::string relocalize = "elo_odometry/relocalize";
+  ASSERT_TRUE(ros::service::waitForService(relocalize, ros::Duration(10.0))) << relocalize;
+  std_srvs::Trigger before_any_pose;
+  ASSERT_TRUE(ros::service::call(relocalize, before_any_pose));
+  EXPECT_FALSE(before_any_pose.response.success) << "nothing to search around before a pose is given";
+  EXPECT_NE(before_any_pose.response.message.find("no pose in the map yet"), std::string::npos)
+      << before_any_pose.response.message;
 
   // base_link in the map at the first scan (the map's frame is the sensor's there), 1.5 m and 8 degrees off.
   const Eigen::Isometry3d base_from_sensor =
@@ -83,6 +91,9 @@ TEST(SimulatedLocalization, LocalizesTheBagFromAnInitialPoseOnTheTopic) {
   }
   EXPECT_LT(worst, 0.15);
   EXPECT_TRUE(tf_buffer.canTransform("map", "base_link", poses.back().header.stamp, ros::Duration(2.0)));
+  std_srvs::Trigger while_tracking;
+  ASSERT_TRUE(ros::service::call(relocalize, while_tracking));
+  EXPECT_TRUE(while_tracking.response.success) << while_tracking.response.message;
 }
 
 }  // namespace

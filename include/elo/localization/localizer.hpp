@@ -94,6 +94,10 @@ class Localizer {
   // (once a pose was found) the next scan searches around it.
   void odometryRestarted();
 
+  // While not tracking: the hint the odometry carries (the last one refused or, once lost, the pose since
+  // the last accepted match), where it puts the last scan processed. nullopt while tracking or with no hint.
+  std::optional<PoseHint> carriedHint() const;
+
   LocalizationState state() const { return state_; }
   const Eigen::Isometry3d& mapFromOdom() const { return map_from_odom_; }
   const MapCloud& map() const { return *map_; }
@@ -137,8 +141,6 @@ class Localizer {
   };
   // `hint`, given for the scan just processed, carried on by the odometry.
   CarriedHint carried(const PoseHint& hint) const;
-  // The carried hint where the odometry puts the scan just processed.
-  PoseHint carriedHintNow() const;
   // Whether this scan searches around the carried hint: every lost_after scans while not tracking.
   bool searchDue() const;
   void accept(const Match& match, LocalizationResult& result);

@@ -250,8 +250,9 @@ Localizer::CarriedHint Localizer::carried(const PoseHint& hint) const {
   return {hint.map_from_sensor * odometry_.modelPose().inverse(), hint.radius, hint.yaw_deg};
 }
 
-PoseHint Localizer::carriedHintNow() const {
-  return {carried_hint_->map_from_odom * odometry_.modelPose(), carried_hint_->radius, carried_hint_->yaw_deg};
+std::optional<PoseHint> Localizer::carriedHint() const {
+  if (!carried_hint_) return std::nullopt;
+  return PoseHint{carried_hint_->map_from_odom * odometry_.modelPose(), carried_hint_->radius, carried_hint_->yaw_deg};
 }
 
 void Localizer::relocalize(const PoseHint& hint, LocalizationResult& result) {
@@ -312,7 +313,7 @@ LocalizationResult Localizer::update(const FrameResult& frame) {
     } else if (state_ == LocalizationState::tracking) {
       track(result);
     } else if (searchDue()) {
-      relocalize(carriedHintNow(), result);
+      relocalize(*carriedHint(), result);
     }
     if (!result.matched) ++scans_since_match_;
     last_odometry_pose_ = frame.pose;
