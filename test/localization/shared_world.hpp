@@ -98,6 +98,21 @@ class Drive {
   double radius_;
 };
 
+// The map's points that lie more than `metres` ahead of `pose` (along its x axis): the map of a drive that
+// began further along the road.
+inline MapCloud mapAheadOf(const MapCloud& map, const Eigen::Isometry3d& pose, double metres) {
+  const Eigen::Vector3f origin = pose.translation().cast<float>();
+  const Eigen::Vector3f forward = pose.rotation().col(0).cast<float>();
+  MapCloud ahead;
+  for (size_t i = 0; i < map.size(); ++i) {
+    if ((map.points[i] - origin).dot(forward) <= metres) continue;
+    ahead.points.push_back(map.points[i]);
+    ahead.normals.push_back(map.normals[i]);
+    if (!map.intensity.empty()) ahead.intensity.push_back(map.intensity[i]);
+  }
+  return ahead;
+}
+
 // A scan and the sensor's true pose at its stamp, in the map's frame.
 using PlacedScan = std::function<std::pair<PointCloud, Eigen::Isometry3d>(int frame)>;
 

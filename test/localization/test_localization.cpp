@@ -184,21 +184,6 @@ TEST_F(Localization, AWrongHintIsNeverAccepted) {
   EXPECT_EQ(searches, 4);
 }
 
-// The map's points that lie more than `metres` ahead of `pose` (along its x axis): a map whose mapping
-// drive began further along the road.
-std::shared_ptr<MapCloud> mapAheadOf(const MapCloud& map, const Eigen::Isometry3d& pose, double metres) {
-  const Eigen::Vector3f origin = pose.translation().cast<float>();
-  const Eigen::Vector3f forward = pose.rotation().col(0).cast<float>();
-  auto ahead = std::make_shared<MapCloud>();
-  for (size_t i = 0; i < map.size(); ++i) {
-    if ((map.points[i] - origin).dot(forward) <= metres) continue;
-    ahead->points.push_back(map.points[i]);
-    ahead->normals.push_back(map.normals[i]);
-    if (!map.intensity.empty()) ahead->intensity.push_back(map.intensity[i]);
-  }
-  return ahead;
-}
-
 // A drive that begins short of the mapped road, given its true pose at the first scan (as from GPS): the
 // search there is refused, the scan seeing mostly what the map lacks, and the hint is not dropped. The
 // odometry carries it, through a restart of the odometry too (time going backwards), and the search
@@ -206,7 +191,7 @@ std::shared_ptr<MapCloud> mapAheadOf(const MapCloud& map, const Eigen::Isometry3
 // on the drive tracks.
 TEST_F(Localization, AHintGivenBeforeTheMappedRoadIsTakenOnReachingIt) {
   const Drive drive(*world_, sensorConfig("hdl64"), otherDrive());
-  const std::shared_ptr<MapCloud> ahead = mapAheadOf(*map_, drive.pose(0), 10.0);
+  const auto ahead = std::make_shared<MapCloud>(mapAheadOf(*map_, drive.pose(0), 10.0));
   Odometry odometry(sensorConfig("hdl64"));
   const int lost_after = odometry.config().localization.lost_after;
   Localizer localizer(odometry, ahead);
@@ -294,8 +279,8 @@ TEST_F(Localization, AnOdometryRestartOnASkippedScanKeepsThePoseInTheMap) {
   const FrameResult skipped = odometry.process(ten_points);
   ASSERT_TRUE(skipped.reset && !skipped.processed) << skipped.skip_reason;
   const LocalizationResult held = localizer.update(skipped);
-  EXPECT_LT((held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm(), 0.1)
-      << "the skipped scan keeps the last pose in the map";
+  const double held_error = (held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm();
+  EXPECT_LT(held_error, 0.1) << "the skipped scan keeps the last pose in the map";
 
   double worst = 0.0;
   for (int frame = kRestartAt + 1; frame < kRestartAt + 12; ++frame) {
@@ -308,7 +293,7 @@ TEST_F(Localization, AnOdometryRestartOnASkippedScanKeepsThePoseInTheMap) {
   }
   std::printf("time backwards on a skipped scan while tracking: the pose kept %.3f m from the last scan's truth; "
               "searched at the next scan, worst error over the next 11 scans %.3f m\n",
-              (held.pose.translation() - drive.pose(kRestartAt - 1).translation()).norm(), worst);
+              held_error, worst);
   EXPECT_LT(worst, 0.1);
 }
 

@@ -43,14 +43,8 @@ class LocalizeCli : public testing::Test {
     without_normals.points.push_back(Vec3f::Constant(std::numeric_limits<float>::quiet_NaN()));
     if (!without_normals.intensity.empty()) without_normals.intensity.push_back(0.0f);
     writeMapPcd(directory_->file("map.pcd"), without_normals);
-    // The map of a drive that began further along the road: what lies kMapStartsAhead ahead of the first scan.
-    MapCloud ahead;
-    for (size_t i = 0; i < map.size(); ++i) {
-      if (map.points[i].x() <= kMapStartsAhead) continue;
-      ahead.points.push_back(map.points[i]);
-      ahead.normals.push_back(map.normals[i]);
-    }
-    writeMapPcd(directory_->file("map_ahead.pcd"), ahead);
+    // The map of a drive that began further along the road (the map's frame is the first scan's).
+    writeMapPcd(directory_->file("map_ahead.pcd"), mapAheadOf(map, Eigen::Isometry3d::Identity(), kMapStartsAhead));
   }
   static void TearDownTestSuite() { directory_.reset(); }
 
