@@ -253,6 +253,12 @@ class Report {
       std::printf(", %zu degenerate (the motion prior kept along what the scan did not constrain)",
                   odometry.degenerateCount());
     }
+    if (odometry.startSearchCount() > 0) {
+      std::printf(", %zu start%s in motion searched", odometry.startSearchCount(), odometry.startSearchCount() > 1 ? "s" : "");
+      if (odometry.ambiguousStartCount() > 0) {
+        std::printf(" (%zu ambiguous: another motion fit about as well)", odometry.ambiguousStartCount());
+      }
+    }
     if (odometry.sensorMisfitCount() > 0) {
       std::printf(", %zu not fitting the sensor model (the warning above)", odometry.sensorMisfitCount());
     }

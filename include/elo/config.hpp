@@ -216,6 +216,24 @@ struct LocalizationConfig {
   double search_margin = 0.05;
 };
 
+// The start in motion (docs/start_in_motion.md): a scan registered when no motion is known yet (the first
+// registration after a start, a reset or a restart) has its motion searched for first, so that odometry
+// started on a moving vehicle tracks from its second scan. Candidates lie along the sensor's x axis,
+// forward and back, and in yaw; each is registered a few steps and scored by how well it fits.
+struct StartSearchConfig {
+  bool enabled = true;
+  // m/s: the candidates along x reach max_speed times the time between the two scans either way: 4 m at
+  // 10 Hz, 144 km/h.
+  double max_speed = 40.0;
+  double step = 1.0;  // m between candidates along x: a candidate half a step off converges in its few steps
+  // deg/s: the candidates in yaw reach this times the time between the scans either way (3 deg at 10 Hz).
+  double max_yaw_rate_deg = 30.0;
+  double yaw_step_deg = 3.0;  // deg between candidates in yaw
+  // A candidate that ended elsewhere and scored within this of the winner makes the start ambiguous:
+  // taken, counted and reported, as the scan does not tell the two motions apart.
+  double margin = 0.02;
+};
+
 struct Config {
   SensorConfig sensor;
   GroundConfig ground;
@@ -227,6 +245,7 @@ struct Config {
   MapConfig map;
   RuntimeConfig runtime;
   LocalizationConfig localization;
+  StartSearchConfig start_search;
 };
 
 // A parameter that YAML files, ROS parameters and command lines all set by the same dotted key

@@ -23,6 +23,9 @@ class MotionModel {
   // 5 m after 10 s at 10 Hz).
   void holdVelocityAlong(const Matrix6d& projector);
   void reset() { history_ = 0; }
+  // Whether any increment was recorded since the last reset: before it the motion is unknown, not zero
+  // (Odometry searches it: start_search.hpp).
+  bool known() const { return history_ > 0; }
   // The velocity (twist per second) of the increment recorded last; zero before any. What a sweep is
   // deskewed under before it is registered: the constant-acceleration extrapolation doubles the noise of
   // the registrations it extrapolates, and the deskew feeds that noise back into the next registration

@@ -11,6 +11,7 @@
 #include "elo/config.hpp"
 #include "elo/motion_prior.hpp"
 #include "elo/registration.hpp"
+#include "elo/start_search.hpp"
 
 namespace elo {
 
@@ -18,7 +19,7 @@ namespace elo {
 struct StageTimes {
   double projection = 0.0;
   double feature_extraction = 0.0;  // ground segmentation + normals + BEV map
-  double registration = 0.0;  // deskew rounds within it excluded
+  double registration = 0.0;  // deskew rounds within it excluded, a start search included
   double deskew = 0.0;  // deskewing the scan again in place and rebuilding its ground map, over the rounds
   double model_update = 0.0;
   double total = 0.0;
@@ -34,6 +35,9 @@ struct FrameResult {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // sensor in the odometry frame
   Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();  // T^{t-1}_t
   RegistrationResult registration;  // of the last round
+  // The start in motion: the search for the motion of a scan registered with none known (searched: the
+  // first registration after a start, a reset or a restart, with start_search.enabled).
+  StartSearchResult start_search;
   // Motion compensation (docs/deskew.md): where the points' times came from (none: the scan was taken as
   // instantaneous), the rounds of deskewing again with the registered motion, and why the cloud's own
   // times were not used or not all used (empty when they were, or when none were asked for).
@@ -88,6 +92,9 @@ class Odometry {
   const std::map<std::string, size_t>& timeWarningCounts() const { return time_warnings_; }
   // Scans with a FrameResult::sensor_warning.
   size_t sensorMisfitCount() const { return sensor_misfits_; }
+  // Start searches run (FrameResult::start_search), and those whose winner did not stand out.
+  size_t startSearchCount() const { return start_searches_; }
+  size_t ambiguousStartCount() const { return ambiguous_starts_; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -123,6 +130,9 @@ class Odometry {
   // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
   Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
                              FrameResult& result);
+  // The registration's initial guess: the motion prior's prediction, or where the start search puts the
+  // scan when no motion is known yet (recorded in `result`).
+  Eigen::Isometry3d initialGuess(double dt, FrameResult& result);
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
   void deskewScanAgain(const Vector6d& velocity, FrameResult& result);
 
@@ -150,6 +160,8 @@ class Odometry {
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> time_warnings_;
   size_t sensor_misfits_ = 0;
+  size_t start_searches_ = 0;
+  size_t ambiguous_starts_ = 0;
 };
 
 }  // namespace elo

@@ -223,6 +223,16 @@ std::vector<Parameter> parameters(Config& c) {
                 "best-scored search candidates registered to convergence"),
       bindField("localization.search_margin", c.localization.search_margin,
                 "inlier share by which a search's winner must beat a candidate that converged elsewhere"),
+      bindField("start_search.enabled", c.start_search.enabled,
+                "search the motion of a scan registered with none known (a start on a moving vehicle)"),
+      bindField("start_search.max_speed", c.start_search.max_speed,
+                "m/s: the start search's candidates reach this times the scan interval along x, either way"),
+      bindField("start_search.step", c.start_search.step, "m between the start search's candidates along x"),
+      bindField("start_search.max_yaw_rate_deg", c.start_search.max_yaw_rate_deg,
+                "deg/s: the start search's candidates reach this times the scan interval in yaw, either way"),
+      bindField("start_search.yaw_step_deg", c.start_search.yaw_step_deg, "deg between the start search's yaws"),
+      bindField("start_search.margin", c.start_search.margin,
+                "fit score within which a candidate that ended elsewhere makes a start ambiguous"),
   };
 }
 
@@ -327,6 +337,12 @@ void validate(const Config& c) {
   validate(c.map);
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
   validateLocalization(c.localization);
+  const StartSearchConfig& start = c.start_search;
+  require(start.max_speed >= 0.0, "start_search.max_speed", "must not be negative");
+  require(start.step > 0.0, "start_search.step", "must be positive");
+  require(start.max_yaw_rate_deg >= 0.0, "start_search.max_yaw_rate_deg", "must not be negative");
+  require(start.yaw_step_deg > 0.0, "start_search.yaw_step_deg", "must be positive");
+  require(start.margin >= 0.0, "start_search.margin", "must not be negative");
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

@@ -99,6 +99,14 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, 
   return deskewed_under;
 }
 
+Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
+  if (motion_.known() || !config_.start_search.enabled) return motion_.predict(dt);
+  result.start_search = searchStartMotion(*backend_, dt, config_);
+  ++start_searches_;
+  if (result.start_search.ambiguous) ++ambiguous_starts_;
+  return result.start_search.motion;
+}
+
 FrameResult Odometry::process(const PointCloud& cloud) {
   const auto start = Clock::now();
   FrameResult result;
@@ -134,7 +142,6 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   // The motion is estimated between the scans' reference instants: the stamps' interval, moved by how the
   // references lie within their sweeps (0 but for `field` times).
   const double dt = started_ ? since_first - last_since_first_ + (times.reference - last_reference_) : 0.0;
-  const Eigen::Isometry3d guess = started_ ? motion_.predict(dt) : Eigen::Isometry3d::Identity();
 
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
@@ -161,7 +168,9 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   Eigen::Isometry3d reference_delta = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d stamp_in_reference = Eigen::Isometry3d::Identity();
   if (started_) {
+    const Eigen::Isometry3d guess = initialGuess(dt, result);
     const Vector6d deskewed_under = registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
+    result.times.registration += result.start_search.milliseconds;
     reference_delta = result.registration.model_from_scan;
     // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference`
     // seconds before the reference instant) is exp(-reference * velocity) in the reference frame.

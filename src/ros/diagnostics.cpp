@@ -25,6 +25,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(restarts, "odometry restarts");
   add(time_warnings, "scans with unusable per-point times");
   add(sensor_misfits, "scans not fitting the sensor model");
+  add(ambiguous_starts, "ambiguous starts (the motion at a start not told apart)");
   return text.str();
 }
 
@@ -84,6 +85,11 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
     ++window_.sensor_misfits;
     last_sensor_warning_ = result.sensor_warning;
   }
+  if (result.start_search.searched) ++start_searches_;
+  if (result.start_search.ambiguous) {
+    ++ambiguous_starts_;
+    ++window_.ambiguous_starts;
+  }
   if (result.registration.iterations > 0) last_registration_ = result.registration;
 }
 
@@ -124,6 +130,8 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("scans dropped", dropped_);
   status.add("registrations failed", failed_registrations_);
   status.add("scans degenerate", degenerate_scans_);
+  status.add("start searches", start_searches_);
+  status.add("ambiguous starts", ambiguous_starts_);
   for (const auto& [reason, count] : rejected_) status.add("clouds rejected: " + reason, count);
   for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
   for (const auto& [reason, count] : restarts_) status.add("odometry restarts: " + reason, count);

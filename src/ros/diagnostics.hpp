@@ -48,6 +48,7 @@ class PipelineStatistics {
     size_t restarts = 0;
     size_t time_warnings = 0;
     size_t sensor_misfits = 0;
+    size_t ambiguous_starts = 0;
     double processing_ms_sum = 0.0;
     double processing_ms_max = 0.0;
     double latency_ms_sum = 0.0;
@@ -65,6 +66,8 @@ class PipelineStatistics {
   size_t dropped_ = 0;
   size_t failed_registrations_ = 0;
   size_t degenerate_scans_ = 0;
+  size_t start_searches_ = 0;    // elo::FrameResult::start_search
+  size_t ambiguous_starts_ = 0;  // ... whose winner did not stand out
   std::map<std::string, size_t> rejected_;
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> restarts_;

@@ -204,6 +204,7 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
     NODELET_WARN_THROTTLE(kWarningPeriod, "per-point times: %s (deskew.time_source)", result.time_warning.c_str());
   }
   if (!result.sensor_warning.empty()) NODELET_WARN_THROTTLE(kWarningPeriod, "%s", result.sensor_warning.c_str());
+  logStartSearch(result.start_search);
   if (!result.processed) {
     lock.unlock();
     statistics_.scanSkipped(result.skip_reason);
@@ -225,6 +226,19 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   const double latency_ms = std::chrono::duration<double, std::milli>(Clock::now() - queued.received).count();
   statistics_.scanProcessed(result, latency_ms);
   feedMap(result, converted.cloud, map_pose, map_generation);
+}
+
+void OdometryNodelet::logStartSearch(const elo::StartSearchResult& search) {
+  if (!search.searched) return;
+  const Eigen::Vector3d moved = search.motion.translation();
+  if (search.ambiguous) {
+    NODELET_WARN("start in motion: ambiguous, another motion fits the first two scans about as well (score %.3f "
+                 "against %.3f); taken: %.2f m forward, which the scans do not confirm",
+                 search.score, search.rival_score, moved.x());
+  } else {
+    NODELET_INFO("start in motion: %.2f m forward between the first two scans (%d candidates, %.0f ms)", moved.x(),
+                 search.candidates, search.milliseconds);
+  }
 }
 
 void OdometryNodelet::feedMap(const elo::FrameResult& result, const elo::PointCloud& cloud,

@@ -35,6 +35,29 @@ TEST(RosDiagnostics, QuietWindowIsOk) {
   EXPECT_EQ(valueOf(status, "scans processed"), "1");
 }
 
+// A start in motion is counted; one the scans could not tell apart warns for the window it fell in.
+TEST(RosDiagnostics, StartSearchesAreCountedAndAnAmbiguousOneWarns) {
+  elo_ros::PipelineStatistics statistics;
+  elo::FrameResult searched = processedScan(60.0);
+  searched.start_search.searched = true;
+  statistics.cloudReceived();
+  statistics.scanProcessed(searched, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper clear;
+  statistics.report(clear);
+  EXPECT_EQ(clear.level, diagnostic_msgs::DiagnosticStatus::OK) << clear.message;
+  EXPECT_EQ(valueOf(clear, "start searches"), "1");
+
+  searched.start_search.ambiguous = true;
+  statistics.cloudReceived();
+  statistics.scanProcessed(searched, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper ambiguous;
+  statistics.report(ambiguous);
+  EXPECT_EQ(ambiguous.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(ambiguous.message.find("1 ambiguous start"), std::string::npos) << ambiguous.message;
+  EXPECT_EQ(valueOf(ambiguous, "start searches"), "2");
+  EXPECT_EQ(valueOf(ambiguous, "ambiguous starts"), "1");
+}
+
 TEST(RosDiagnostics, DropsRejectionsAndSkipsWarnAndAreCounted) {
   elo_ros::PipelineStatistics statistics;
   statistics.cloudReceived();

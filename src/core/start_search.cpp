@@ -1,0 +1,116 @@
+#include "elo/start_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/elapsed_time.hpp"
+#include "elo/registration.hpp"
+
+namespace elo {
+namespace {
+
+// Gauss-Newton steps a candidate is registered for before it is scored: from the loose kernel the three
+// bring a candidate within about half a step of the motion to within centimetres of it, while one farther
+// off stays where the surfaces facing the motion do not fit.
+constexpr int kCandidateIterations = 3;
+// Candidates along x either way at most: a scan long after the model's (dropped scans right after a
+// start) is searched over this many steps, not over its whole max_speed * dt.
+constexpr int kMaxStepsEachWay = 20;
+
+struct Candidate {
+  Eigen::Isometry3d motion;
+  double score;
+};
+
+// Steps of `step` within `reach` either side of zero, at most `limit` each way: -n..n.
+int stepsWithin(double reach, double step, int limit) {
+  return std::min(limit, static_cast<int>(std::floor(reach / step + 1e-9)));
+}
+
+// 0, -1, 1, -2, 2, ... -n, n: the offsets of a line of candidates, nearest the centre first.
+std::vector<int> offsetsWithin(int n) {
+  std::vector<int> offsets{0};
+  for (int i = 1; i <= n; ++i) offsets.insert(offsets.end(), {-i, i});
+  return offsets;
+}
+
+// Candidates along x every step within `reach` either way, the identity first.
+std::vector<Eigen::Isometry3d> motionsAlongX(double reach, const StartSearchConfig& config) {
+  std::vector<Eigen::Isometry3d> motions;
+  for (int offset : offsetsWithin(stepsWithin(reach, config.step, kMaxStepsEachWay))) {
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    motion.translation().x() = offset * config.step;
+    motions.push_back(motion);
+  }
+  return motions;
+}
+
+// `centre` turned by every yaw step within `yaw_reach` (rad) either way, `centre` itself left out.
+std::vector<Eigen::Isometry3d> yawsAround(const Eigen::Isometry3d& centre, double yaw_reach,
+                                          const StartSearchConfig& config) {
+  const double yaw_step = config.yaw_step_deg * M_PI / 180.0;
+  std::vector<Eigen::Isometry3d> motions;
+  for (int offset : offsetsWithin(stepsWithin(yaw_reach, yaw_step, kMaxStepsEachWay))) {
+    if (offset == 0) continue;
+    Eigen::Isometry3d motion = centre;
+    motion.linear() = Eigen::AngleAxisd(offset * yaw_step, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    motions.push_back(motion);
+  }
+  return motions;
+}
+
+Candidate registerCandidate(Backend& backend, const Eigen::Isometry3d& from, const RegistrationConfig& config) {
+  RegistrationConfig short_registration = config;
+  short_registration.max_iterations = kCandidateIterations;
+  const RegistrationResult registered = registerScan(backend, from, false, short_registration);
+  const NormalEquations fit = backend.linearize(registered.model_from_scan, config.robust_kernel_scale);
+  return {registered.model_from_scan, registered.failed ? 0.0 : fitScore(fit, config)};
+}
+
+bool endedElsewhere(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, const StartSearchConfig& config) {
+  const Eigen::Isometry3d apart = a.inverse() * b;
+  const double degrees = Eigen::AngleAxisd(apart.rotation()).angle() * 180.0 / M_PI;
+  return apart.translation().norm() > 0.5 * config.step || degrees > 0.5 * config.yaw_step_deg;
+}
+
+}  // namespace
+
+double fitScore(const NormalEquations& sums, const RegistrationConfig& config) {
+  const TermSums& term = config.terms == CostTerms::bev_ground ? sums.ground : sums.nonground;
+  if (term.candidates == 0) return 0.0;
+  return term.JtJ.topLeftCorner<3, 3>().trace() / term.candidates;
+}
+
+StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config) {
+  const auto start = Clock::now();
+  const StartSearchConfig& search = config.start_search;
+  const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * dt;
+  // Along x first, then in yaw around the candidate that started nearest the best along x: a turn
+  // within the search's yaw reach hardly moves where the scan fits along x (so the two are searched
+  // one after the other, not on a grid of their product, at a third of its cost).
+  std::vector<Candidate> scored;
+  const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(search.max_speed * dt, search);
+  for (const Eigen::Isometry3d& motion : along_x) scored.push_back(registerCandidate(backend, motion, config.registration));
+  const auto better = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
+  const size_t best_along_x = std::min_element(scored.begin(), scored.end(), better) - scored.begin();
+  for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x], yaw_reach, search)) {
+    scored.push_back(registerCandidate(backend, motion, config.registration));
+  }
+  const Candidate winner = *std::min_element(scored.begin(), scored.end(), better);
+  StartSearchResult result;
+  result.searched = true;
+  result.candidates = static_cast<int>(scored.size());
+  result.motion = winner.motion;
+  result.score = winner.score;
+  for (const Candidate& candidate : scored) {
+    if (endedElsewhere(winner.motion, candidate.motion, search)) {
+      result.rival_score = std::max(result.rival_score, candidate.score);
+    }
+  }
+  result.ambiguous = result.rival_score > 0.0 && result.rival_score >= winner.score - search.margin;
+  result.milliseconds = millisecondsSince(start);
+  return result;
+}
+
+}  // namespace elo
