@@ -79,7 +79,7 @@ struct Options {
   bool tum = false;
   std::vector<double> segment_lengths = elo::kittiSegmentLengths();
   bool breakdown = false;
-  size_t start = 0;
+  std::optional<size_t> start;  // --start: the estimate covers the ground truth from this pose on
   std::vector<size_t> pose_errors;
 };
 
@@ -121,7 +121,7 @@ Options parseArguments(int argc, char** argv) {
   if (options.ground_truth.empty() && !options.map_entropy_scans && !options.reverse) {
     throw UsageError("--gt is required unless --map-entropy or --reverse is given");
   }
-  if (options.ground_truth.empty() && (options.breakdown || options.start > 0 || !options.pose_errors.empty())) {
+  if (options.ground_truth.empty() && (options.breakdown || options.start || !options.pose_errors.empty())) {
     throw UsageError("--breakdown, --start and --pose-errors compare with the ground truth: --gt is required");
   }
   if ((options.map_entropy_scans || options.reverse) && fs::is_directory(options.estimate)) {
@@ -231,7 +231,7 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
                                         std::vector<PoseErrorRow>& pose_errors) {
   const std::vector<Eigen::Isometry3d> estimate = readTrajectory(files.estimate, options.tum);
   std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
-  if (options.start > 0) ground_truth = groundTruthFrom(ground_truth, options.start, estimate.size(), files.ground_truth);
+  if (options.start) ground_truth = groundTruthFrom(ground_truth, *options.start, estimate.size(), files.ground_truth);
   elo::TrajectoryEvaluation evaluation;
   try {
     evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate, options.segment_lengths);

@@ -130,6 +130,13 @@ TEST_F(EloEvalCli, StartAndPoseErrorsScoreARunStartedMidDrive) {
   EXPECT_EQ(beyond.exit_code, 2);
   EXPECT_TRUE(contains(beyond.output, "too few for 20 estimated poses from pose 1190 on")) << beyond.output;
   EXPECT_EQ(runEloEval(files + " --start 100 --pose-errors 20").exit_code, 2);
+  // --start 0: a run of the drive's first scans, scored against as many ground-truth poses.
+  std::vector<Eigen::Isometry3d> first_scans(ground_truth_.begin(), ground_truth_.begin() + 20);
+  writeKittiPoses(directory_.file("first.txt"), first_scans);
+  const CommandResult from_zero = runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " +
+                                             directory_.file("first.txt") + " --start 0 --pose-errors 10");
+  EXPECT_EQ(from_zero.exit_code, 0) << from_zero.output;
+  EXPECT_TRUE(contains(from_zero.output, "first          10          0.0000")) << from_zero.output;
 }
 
 TEST_F(EloEvalCli, TumFiles) {
