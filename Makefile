@@ -1,9 +1,9 @@
 # Entry points for a fresh Debian 12 machine. `make demo` installs what is missing, builds and runs the
 # odometry on a simulated drive; `make test` does the same and runs every test but the long drives, which
 # `make test-long` runs; `make bench` prints the speed figures; `make accuracy` the accuracy table on
-# simulated sequences. `make test-sanitize` runs the suite under AddressSanitizer +
-# UndefinedBehaviorSanitizer and the core's tests under ThreadSanitizer; `make fuzz` runs every libFuzzer
-# target for FUZZ_SECONDS (needs clang, which it installs); `make rviz-screenshot` replays a simulated
+# simulated sequences, `make accuracy-real` the one on the real KITTI-raw drives (docs/real_drives.md).
+# `make test-sanitize` runs the suite under AddressSanitizer + UndefinedBehaviorSanitizer and the core's
+# tests under ThreadSanitizer; `make fuzz` runs every libFuzzer target for FUZZ_SECONDS (needs clang, which it installs); `make rviz-screenshot` replays a simulated
 # drive into rviz on a virtual screen and saves docs/rviz.png and docs/rviz_map.png; `make gpu-check` checks and measures the
 # CUDA backend on a GPU machine.
 SHELL := /bin/bash
@@ -23,7 +23,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
 
 .PHONY: deps build test test-long compat compat-poses test-sanitize test-asan test-tsan test-baseline test-aarch64 deps-aarch64 fuzz \
-  bench demo accuracy soak rviz-screenshot gpu-check clean
+  bench demo accuracy accuracy-real soak rviz-screenshot gpu-check clean
 
 # Installs only what is missing, so a second run needs no network.
 deps:
@@ -160,6 +160,13 @@ demo: build
 # The accuracy table over simulated worlds, sensors and modes.
 accuracy: build
 	tools/accuracy.sh $(BUILD) $(SHARED_DATA)
+
+# The accuracy tables on the real KITTI-raw drives with ground truth under REAL_DRIVES (docs/real_drives.md):
+# drift over 10-100 m segments with its breakdown, and starts in motion; KISS_RUN=path/to/kiss_run adds
+# KISS-ICP's rows. Says where it looked and succeeds when there is no drive.
+REAL_DRIVES ?= $(abspath ../real_drives)
+accuracy-real: build
+	tools/accuracy_real.sh $(BUILD) $(REAL_DRIVES)
 
 # The soak test: SOAK_SCANS simulated HDL-64E scans (default 20000, 33 min at 10 Hz) through the nodelet at
 # SOAK_RATE times the sensor's rate; fails when memory grows after warm-up or a scan goes unexplained.

@@ -2,11 +2,13 @@
 // errors that name the flag, and one exit-code convention (0 success, 1 failure, 2 bad usage).
 #pragma once
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 namespace elo::tools {
 
@@ -32,6 +34,20 @@ T parseNumber(const std::string& flag, const std::string& text) {
   } catch (const std::exception&) {
   }
   throw UsageError(flag + " expects " + (std::is_integral_v<T> ? "an integer" : "a number") + ", got '" + text + "'");
+}
+
+// `text`, numbers separated by commas ("10,20,50"), each read whole as type T; a UsageError naming
+// `flag` for an empty list or a bad number.
+template <typename T>
+std::vector<T> parseNumberList(const std::string& flag, const std::string& text) {
+  std::vector<T> numbers;
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    const size_t comma = std::min(text.find(',', begin), text.size());
+    numbers.push_back(parseNumber<T>(flag, text.substr(begin, comma - begin)));
+    begin = comma + 1;
+  }
+  return numbers;
 }
 
 class Arguments {

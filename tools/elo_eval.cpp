@@ -26,12 +26,13 @@ namespace {
 constexpr int kExitBadInput = 2;
 
 const char* const kUsage =
-    "usage: elo_eval --gt GT --est EST [--plot PNG] [--tum]\n"
+    "usage: elo_eval --gt GT --est EST [--segments L,...] [--breakdown] [--start S] [--pose-errors K,...]\n"
+    "                [--plot PNG] [--tum]\n"
     "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
     "       elo_eval --est EST --reverse REV\n"
     "\n"
     "Evaluates estimated trajectories against ground truth with the KITTI odometry metric (t_rel, r_rel over\n"
-    "segments of 100..800 m; t_rel_xy: t_rel's horizontal part, the error's x-y in the LiDAR frame), the\n"
+    "segments of 100..800 m or --segments; t_rel_xy: t_rel's horizontal part, the error's x-y in the LiDAR frame), the\n"
     "relative pose error between consecutive frames and the absolute trajectory error after a rigid alignment. Without ground truth, --map-entropy scores one trajectory by the sharpness\n"
     "of the map its scans make, and --reverse by how far it and a run over the same scans in reverse fail to\n"
     "close.\n"
@@ -43,6 +44,19 @@ const char* const kUsage =
     "               directories, sequence NN goes to PNG with _NN before the extension and the pooled errors\n"
     "               to PNG itself\n"
     "  --tum        the files are TUM trajectories (t x y z qx qy qz qw) instead of KITTI poses\n"
+    "  --segments L,...\n"
+    "               the segment lengths in metres (default the devkit's 100,200,...,800); short drives are\n"
+    "               scored with --segments 10,20,50,100 (docs/real_drives.md); segments still start every\n"
+    "               10th frame\n"
+    "  --breakdown  also print each sequence's segment error split into what is wrong: heading, pitch and\n"
+    "               roll (deg/100m, mean absolute), along-track (%, signed: + when the estimate travels too\n"
+    "               far, a scale error), cross-track and height (%, mean absolute), in the frame of each\n"
+    "               segment's last ground-truth pose (x forward, y left, z up)\n"
+    "  --start S    the estimate's pose 0 is the ground truth's pose S (elo_run --start S): the ground\n"
+    "               truth is read from pose S on, as many poses as the estimate has\n"
+    "  --pose-errors K,...\n"
+    "               also print the error of each estimate pose K in the frame of its pose 0, against the\n"
+    "               ground truth's likewise (m, deg): what a run started in motion gets wrong at first\n"
     "  --map-entropy SCANS\n"
     "               the scans EST was estimated from (a directory as elo_run reads, one pose per scan): builds\n"
     "               the map of their points at 3..30 m and prints its mean map entropy (nats, lower is\n"
@@ -63,6 +77,10 @@ struct Options {
   std::optional<std::string> map_entropy_scans;
   std::optional<std::string> reverse;
   bool tum = false;
+  std::vector<double> segment_lengths = elo::kittiSegmentLengths();
+  bool breakdown = false;
+  std::optional<size_t> start;  // --start: the estimate covers the ground truth from this pose on
+  std::vector<size_t> pose_errors;
 };
 
 using elo::tools::UsageError;
@@ -83,6 +101,18 @@ Options parseArguments(int argc, char** argv) {
       options.map_entropy_scans = arguments.value();
     } else if (arguments.is("--reverse")) {
       options.reverse = arguments.value();
+    } else if (arguments.is("--segments")) {
+      options.segment_lengths = elo::tools::parseNumberList<double>("--segments", arguments.value());
+      const auto not_positive = [](double length) { return !(length > 0.0); };
+      if (std::any_of(options.segment_lengths.begin(), options.segment_lengths.end(), not_positive)) {
+        throw UsageError("--segments expects lengths above 0 m");
+      }
+    } else if (arguments.is("--breakdown")) {
+      options.breakdown = true;
+    } else if (arguments.is("--start")) {
+      options.start = arguments.number<size_t>();
+    } else if (arguments.is("--pose-errors")) {
+      options.pose_errors = elo::tools::parseNumberList<size_t>("--pose-errors", arguments.value());
     } else {
       arguments.rejectFlag();
     }
@@ -90,6 +120,9 @@ Options parseArguments(int argc, char** argv) {
   if (options.estimate.empty()) throw UsageError("--est is required");
   if (options.ground_truth.empty() && !options.map_entropy_scans && !options.reverse) {
     throw UsageError("--gt is required unless --map-entropy or --reverse is given");
+  }
+  if (options.ground_truth.empty() && (options.breakdown || options.start || !options.pose_errors.empty())) {
+    throw UsageError("--breakdown, --start and --pose-errors compare with the ground truth: --gt is required");
   }
   if ((options.map_entropy_scans || options.reverse) && fs::is_directory(options.estimate)) {
     throw UsageError("--map-entropy and --reverse score one trajectory: --est must be a file");
@@ -143,6 +176,18 @@ std::string plotPathFor(const std::string& png, const std::string& sequence) {
   return (path.parent_path() / (path.stem().string() + "_" + sequence + path.extension().string())).string();
 }
 
+// The ground truth of a run started at scan `start` (elo_run --start): its poses from `start` on, as many
+// as the estimate has.
+std::vector<Eigen::Isometry3d> groundTruthFrom(const std::vector<Eigen::Isometry3d>& ground_truth, size_t start,
+                                               size_t poses, const std::string& path) {
+  if (start + poses > ground_truth.size()) {
+    throw elo::IoError("'" + path + "' has " + std::to_string(ground_truth.size()) + " poses, too few for " +
+                       std::to_string(poses) + " estimated poses from pose " + std::to_string(start) + " on");
+  }
+  return {ground_truth.begin() + static_cast<std::ptrdiff_t>(start),
+          ground_truth.begin() + static_cast<std::ptrdiff_t>(start + poses)};
+}
+
 void printHeader() {
   std::printf("%-10s %8s %11s %9s %16s %12s %11s %9s %12s\n", "sequence", "frames", "length(m)", "t_rel(%)",
               "r_rel(deg/100m)", "RPE_trans(m)", "RPE_rot(deg)", "ATE(m)", "t_rel_xy(%)");
@@ -155,12 +200,44 @@ void printRow(const elo::TrajectoryEvaluation& evaluation) {
               evaluation.ate.translation_rmse_m, evaluation.drift.t_rel_horizontal_percent);
 }
 
-elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Options& options, bool plot_per_sequence) {
-  const std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
+void printBreakdownHeader() {
+  std::printf("%-10s %18s %16s %15s %9s %9s %10s\n", "sequence", "heading(deg/100m)", "pitch(deg/100m)",
+              "roll(deg/100m)", "along(%)", "cross(%)", "height(%)");
+}
+
+void printBreakdownRow(const elo::TrajectoryEvaluation& evaluation) {
+  const elo::ErrorBreakdown& breakdown = evaluation.breakdown;
+  std::printf("%-10s %18.4f %16.4f %15.4f %+9.4f %9.4f %10.4f\n", evaluation.name.c_str(),
+              breakdown.heading_deg_per_100m, breakdown.pitch_deg_per_100m, breakdown.roll_deg_per_100m,
+              breakdown.along_track_percent, breakdown.cross_track_percent, breakdown.height_percent);
+}
+
+// One row of --pose-errors.
+struct PoseErrorRow {
+  std::string sequence;
+  size_t pose = 0;
+  elo::PoseError error;
+};
+
+void printPoseErrors(const std::vector<PoseErrorRow>& rows) {
+  std::printf("%-10s %6s %15s %14s\n", "sequence", "pose", "translation(m)", "rotation(deg)");
+  for (const PoseErrorRow& row : rows) {
+    std::printf("%-10s %6zu %15.4f %14.4f\n", row.sequence.c_str(), row.pose, row.error.translation_m,
+                row.error.rotation_deg);
+  }
+}
+
+elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Options& options, bool plot_per_sequence,
+                                        std::vector<PoseErrorRow>& pose_errors) {
   const std::vector<Eigen::Isometry3d> estimate = readTrajectory(files.estimate, options.tum);
+  std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
+  if (options.start) ground_truth = groundTruthFrom(ground_truth, *options.start, estimate.size(), files.ground_truth);
   elo::TrajectoryEvaluation evaluation;
   try {
-    evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate);
+    evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate, options.segment_lengths);
+    for (size_t pose : options.pose_errors) {
+      pose_errors.push_back({files.name, pose, elo::poseErrorFromFirst(ground_truth, estimate, pose)});
+    }
   } catch (const std::invalid_argument& error) {
     throw elo::IoError("'" + files.ground_truth + "' against '" + files.estimate + "': " + error.what());
   }
@@ -216,8 +293,9 @@ int run(const Options& options) {
   const std::vector<SequenceFiles> sequences = pairSequenceFiles(options);
   const bool directories = fs::is_directory(options.ground_truth);
   std::vector<elo::TrajectoryEvaluation> evaluations;
+  std::vector<PoseErrorRow> pose_errors;
   for (const SequenceFiles& files : sequences) {
-    evaluations.push_back(evaluateFiles(files, options, directories));
+    evaluations.push_back(evaluateFiles(files, options, directories, pose_errors));
   }
   if (directories) {
     evaluations.push_back(elo::poolEvaluations("overall", evaluations));
@@ -226,11 +304,16 @@ int run(const Options& options) {
                           elo::TopView::widest_spread, "all sequences");
     }
   }
-  // The table only once every input has been read, so that an error leaves no partial table.
+  // The tables only once every input has been read, so that an error leaves no partial table.
   printHeader();
   for (const elo::TrajectoryEvaluation& evaluation : evaluations) {
     printRow(evaluation);
   }
+  if (options.breakdown) {
+    printBreakdownHeader();
+    for (const elo::TrajectoryEvaluation& evaluation : evaluations) printBreakdownRow(evaluation);
+  }
+  if (!pose_errors.empty()) printPoseErrors(pose_errors);
   return 0;
 }
 

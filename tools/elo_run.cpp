@@ -49,7 +49,10 @@ options:
   --threads N          CPU threads (default: all)
   --backend cpu|cuda   compute backend (runtime.backend; default cpu)
   --set KEY=VALUE      override one parameter, e.g. --set ground.sensor_height=1.8 (repeatable)
-  --frames N           process only the first N scans (of those --stride and --reverse play)
+  --frames N           process only the first N scans (of those --start, --stride and --reverse play)
+  --start N            play the scans from scan N on, the first of them at the origin: a bag cut
+                       mid-drive, or a node started on a moving car (default 0; not with --reverse);
+                       the poses written are those of scans N, N+K, ... (K: --stride)
   --stride K           play every K-th scan from the first: a faster drive, or dropped frames
                        (default 1); score it against every K-th ground-truth pose
   --reverse            play the scans last to first, the route driven backwards (stamps mirrored
@@ -92,6 +95,7 @@ struct Options {
   std::vector<std::pair<std::string, std::string>> overrides;
   size_t max_frames = 0;
   size_t stride = 1;
+  size_t start = 0;
   bool reverse = false;
   bool strict = false;
   bool prefetch = true;
@@ -131,6 +135,8 @@ Options parseArguments(int argc, char** argv) {
     } else if (arguments.is("--stride")) {
       options.stride = arguments.number<size_t>();
       if (options.stride == 0) throw UsageError("--stride must be at least 1");
+    } else if (arguments.is("--start")) {
+      options.start = arguments.number<size_t>();
     } else if (arguments.is("--reverse")) {
       options.reverse = true;
     } else if (arguments.is("--timing")) {
@@ -162,6 +168,9 @@ Options parseArguments(int argc, char** argv) {
   if (!options.dump_config && (options.input.empty() || options.output.empty())) {
     throw UsageError("--input and --output are required");
   }
+  // A reverse run from scan N would play N, N-1, ..., 0: the drive's start driven backwards, which no
+  // recording holds; the reverse of a cut drive is --reverse over the cut itself.
+  if (options.reverse && options.start > 0) throw UsageError("--start and --reverse cannot be combined");
   return options;
 }
 
@@ -296,6 +305,23 @@ class Report {
   std::vector<double> projection_, upload_, features_, registration_, model_update_, total_, reading_;
   std::map<std::string, size_t> unreadable_;
 };
+
+// The scans the run plays: playOrder's, or with --start every --stride-th scan from scan N, at its
+// recorded stamp (the odometry starts at the first scan it is given, whatever its stamp).
+std::vector<elo::PlayedScan> playedScans(const elo::ScanSource& source, const Options& options) {
+  if (options.start == 0) return elo::playOrder(source, options.stride, options.reverse, options.max_frames);
+  if (options.start >= source.size()) {
+    throw UsageError("--start " + std::to_string(options.start) + ": the input has " + std::to_string(source.size()) +
+                     " scans");
+  }
+  const std::vector<elo::PlayedScan> every = elo::playOrder(source, 1, false);
+  std::vector<elo::PlayedScan> played;
+  for (size_t i = options.start; i < every.size(); i += options.stride) {
+    if (options.max_frames > 0 && played.size() == options.max_frames) break;
+    played.push_back(every[i]);
+  }
+  return played;
+}
 
 void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {
   csv << index << ',' << stamp << ',' << (r.processed ? 1 : 0) << ',' << r.times.projection << ','
@@ -520,7 +546,7 @@ int run(const Options& options) {
   std::printf("input: %s, %zu scans, listed in %.2f s\n", source->describe().c_str(), source->size(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - opening).count());
   if (!source->warning().empty()) std::fprintf(stderr, "warning: %s\n", source->warning().c_str());
-  const std::vector<elo::PlayedScan> played = elo::playOrder(*source, options.stride, options.reverse, options.max_frames);
+  const std::vector<elo::PlayedScan> played = playedScans(*source, options);
   elo::Odometry odometry(config);
   if (!odometry.backendWarning().empty()) std::fprintf(stderr, "warning: %s\n", odometry.backendWarning().c_str());
   const std::string normal_reach = elo::normalReachWarning(config);

@@ -24,14 +24,17 @@ double pooledRmse(const std::vector<Part>& parts, Rmse rmse_of, Count count_of) 
 }  // namespace
 
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
-                                        const std::vector<Eigen::Isometry3d>& estimate) {
+                                        const std::vector<Eigen::Isometry3d>& estimate,
+                                        const std::vector<double>& segment_lengths) {
   TrajectoryEvaluation evaluation;
   evaluation.name = name;
-  evaluation.segments = kittiSegmentErrors(ground_truth, estimate);
+  evaluation.segments = kittiSegmentErrors(ground_truth, estimate, segment_lengths);
   evaluation.frames = ground_truth.size();
   const std::vector<double> distances = trajectoryDistances(ground_truth);
   evaluation.length_m = distances.empty() ? 0.0 : distances.back();
   evaluation.drift = averageDrift(evaluation.segments);
+  evaluation.components = segmentComponents(ground_truth, estimate, evaluation.segments);
+  evaluation.breakdown = averageBreakdown(evaluation.components);
   evaluation.rpe = relativePoseError(ground_truth, estimate);
   evaluation.ate = absoluteTrajectoryError(ground_truth, estimate);
   return evaluation;
@@ -44,10 +47,12 @@ TrajectoryEvaluation poolEvaluations(const std::string& name, const std::vector<
     pooled.frames += sequence.frames;
     pooled.length_m += sequence.length_m;
     pooled.segments.insert(pooled.segments.end(), sequence.segments.begin(), sequence.segments.end());
+    pooled.components.insert(pooled.components.end(), sequence.components.begin(), sequence.components.end());
     pooled.rpe.pairs += sequence.rpe.pairs;
     pooled.ate.frames += sequence.ate.frames;
   }
   pooled.drift = averageDrift(pooled.segments);
+  pooled.breakdown = averageBreakdown(pooled.components);
   pooled.rpe.translation_rmse_m = pooledRmse(
       sequences, [](const auto& s) { return s.rpe.translation_rmse_m; }, [](const auto& s) { return s.rpe.pairs; });
   pooled.rpe.rotation_rmse_deg = pooledRmse(

@@ -5,6 +5,7 @@
 #include <iterator>
 #include <limits>
 #include <optional>
+#include <set>
 
 #include "relative_motion.hpp"
 
@@ -48,12 +49,13 @@ std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& po
 }
 
 std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
-                                             const std::vector<Eigen::Isometry3d>& estimate) {
+                                             const std::vector<Eigen::Isometry3d>& estimate,
+                                             const std::vector<double>& lengths) {
   eval_detail::requireSameLength(ground_truth, estimate);
   const std::vector<double> distances = trajectoryDistances(ground_truth);
   std::vector<SegmentError> segments;
   for (size_t first = 0; first < ground_truth.size(); first += kKittiStartFrameStep) {
-    for (double length : kittiSegmentLengths()) {
+    for (double length : lengths) {
       const std::optional<size_t> last = lastFrameOfSegment(distances, first, length);
       if (!last) {
         continue;
@@ -92,14 +94,14 @@ DriftError averageDrift(const std::vector<SegmentError>& segments) {
 }
 
 std::vector<LengthDriftError> driftByLength(const std::vector<SegmentError>& segments) {
+  std::set<double> lengths;
+  for (const SegmentError& segment : segments) lengths.insert(segment.length);
   std::vector<LengthDriftError> result;
-  for (double length : kittiSegmentLengths()) {
+  for (double length : lengths) {
     std::vector<SegmentError> of_length;
     std::copy_if(segments.begin(), segments.end(), std::back_inserter(of_length),
                  [length](const SegmentError& segment) { return segment.length == length; });
-    if (!of_length.empty()) {
-      result.push_back({length, averageDrift(of_length)});
-    }
+    result.push_back({length, averageDrift(of_length)});
   }
   return result;
 }

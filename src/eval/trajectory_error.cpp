@@ -72,6 +72,19 @@ AbsoluteTrajectoryError absoluteTrajectoryError(const std::vector<Eigen::Isometr
   return ate;
 }
 
+PoseError poseErrorFromFirst(const std::vector<Eigen::Isometry3d>& ground_truth,
+                             const std::vector<Eigen::Isometry3d>& estimate, size_t frame) {
+  if (frame >= ground_truth.size() || frame >= estimate.size()) {
+    throw std::invalid_argument("pose " + std::to_string(frame) + " asked of trajectories of " +
+                                std::to_string(ground_truth.size()) + " and " + std::to_string(estimate.size()) +
+                                " poses");
+  }
+  const Eigen::Isometry3d error =
+      eval_detail::generalInverse(eval_detail::relativeMotion(ground_truth.front(), ground_truth[frame])) *
+      eval_detail::relativeMotion(estimate.front(), estimate[frame]);
+  return {error.translation().norm(), rotationAngleDeg(error.linear())};
+}
+
 ForwardBackwardGap forwardBackwardGap(const std::vector<Eigen::Isometry3d>& forward,
                                       const std::vector<Eigen::Isometry3d>& reverse) {
   if (forward.empty() || forward.size() != reverse.size()) {

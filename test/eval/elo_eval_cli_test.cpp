@@ -71,6 +71,74 @@ TEST_F(EloEvalCli, DirectoriesGiveARowPerSequenceAndOverall) {
   }
 }
 
+// The whitespace-separated fields of the output's first line that starts with `start`.
+std::vector<std::string> fieldsOfRow(const std::string& output, const std::string& start) {
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(start, 0) != 0) continue;
+    std::istringstream words(line);
+    std::vector<std::string> fields;
+    for (std::string word; words >> word;) fields.push_back(word);
+    return fields;
+  }
+  return {};
+}
+
+// The estimate is 1% too long on every segment: the breakdown puts it all along the track, signed.
+TEST_F(EloEvalCli, SegmentsAndBreakdown) {
+  const CommandResult result = runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " +
+                                          directory_.file("est/00.txt") + " --segments 10,50 --breakdown");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_TRUE(contains(result.output, "heading(deg/100m)")) << result.output;
+  const std::vector<std::string> drift = fieldsOfRow(result.output, "00 ");
+  ASSERT_EQ(drift.size(), 9u) << result.output;
+  // Over 1%: a segment ends at the first frame beyond its length, 11 m after its start for 10 m.
+  EXPECT_NEAR(std::stod(drift[3]), 1.05, 0.05) << "t_rel over 10 and 50 m on a gentle curve";
+  std::istringstream after_header(result.output.substr(result.output.find("heading(deg/100m)")));
+  std::string header;
+  std::getline(after_header, header);
+  std::string row;
+  std::getline(after_header, row);
+  const std::vector<std::string> breakdown = fieldsOfRow(row, "00 ");
+  ASSERT_EQ(breakdown.size(), 7u) << result.output;
+  EXPECT_EQ(breakdown[4][0], '+') << "along-track, too far: " << row;
+  EXPECT_NEAR(std::stod(breakdown[4]), std::stod(drift[3]), 1e-3) << row;
+  EXPECT_NEAR(std::stod(breakdown[1]), 0.0, 1e-3) << "heading: " << row;
+  EXPECT_NEAR(std::stod(breakdown[5]), 0.0, 1e-3) << "cross-track: " << row;
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("est/00.txt") +
+                       " --segments 10,x").exit_code, 2);
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("est/00.txt") +
+                       " --segments 0").exit_code, 2);
+  EXPECT_EQ(runEloEval("--est " + directory_.file("est/00.txt") + " --breakdown").exit_code, 2);
+}
+
+// A run started at scan 100 (elo_run --start 100) whose pose 10 is 0.3 m ahead of where it should be:
+// scored against the ground truth from pose 100 on.
+TEST_F(EloEvalCli, StartAndPoseErrorsScoreARunStartedMidDrive) {
+  std::vector<Eigen::Isometry3d> run;
+  for (size_t i = 100; i < 120; ++i) run.push_back(ground_truth_[100].inverse() * ground_truth_[i]);
+  run[10].translation() += run[10].linear() * Eigen::Vector3d(0.3, 0, 0);
+  writeKittiPoses(directory_.file("run.txt"), run);
+  const std::string files = "--gt " + directory_.file("gt/00.txt") + " --est " + directory_.file("run.txt");
+  const CommandResult result = runEloEval(files + " --start 100 --pose-errors 1,10");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "translation(m)")) << result.output;
+  EXPECT_TRUE(contains(result.output, "run             1          0.0000")) << result.output;
+  EXPECT_TRUE(contains(result.output, "run            10          0.3000")) << result.output;
+  EXPECT_EQ(runEloEval(files).exit_code, 2) << "20 poses against 1200 without --start";
+  const CommandResult beyond = runEloEval(files + " --start 1190");
+  EXPECT_EQ(beyond.exit_code, 2);
+  EXPECT_TRUE(contains(beyond.output, "too few for 20 estimated poses from pose 1190 on")) << beyond.output;
+  EXPECT_EQ(runEloEval(files + " --start 100 --pose-errors 20").exit_code, 2);
+  // --start 0: a run of the drive's first scans, scored against as many ground-truth poses.
+  std::vector<Eigen::Isometry3d> first_scans(ground_truth_.begin(), ground_truth_.begin() + 20);
+  writeKittiPoses(directory_.file("first.txt"), first_scans);
+  const CommandResult from_zero = runEloEval("--gt " + directory_.file("gt/00.txt") + " --est " +
+                                             directory_.file("first.txt") + " --start 0 --pose-errors 10");
+  EXPECT_EQ(from_zero.exit_code, 0) << from_zero.output;
+  EXPECT_TRUE(contains(from_zero.output, "first          10          0.0000")) << from_zero.output;
+}
+
 TEST_F(EloEvalCli, TumFiles) {
   std::vector<double> stamps;
   for (size_t i = 0; i < ground_truth_.size(); ++i) stamps.push_back(0.1 * static_cast<double>(i));

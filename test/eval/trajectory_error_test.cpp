@@ -58,6 +58,24 @@ TEST(TrajectoryError, DifferentFrameCountsThrow) {
   EXPECT_THROW(absoluteTrajectoryError(test::circle(5, 1, 0), test::circle(6, 1, 0)), std::invalid_argument);
 }
 
+// A run started mid-drive (elo_run --start) begins at the identity wherever the truth's pose is: the
+// error of pose k compares the motions since each trajectory's first pose, whatever frame each is in.
+TEST(PoseErrorFromFirst, ComparesTheMotionsSinceTheFirstPose) {
+  const std::vector<Eigen::Isometry3d> ground_truth = test::circle(20, 1.0, 0.02);
+  std::vector<Eigen::Isometry3d> estimate;
+  for (const Eigen::Isometry3d& pose : ground_truth) estimate.push_back(ground_truth.front().inverse() * pose);
+  // The estimate's pose 10 ends 0.3 m further along its own x and turned 2 deg more.
+  estimate[10] = estimate[10] * test::translation(Eigen::Vector3d(0.3, 0, 0)) * test::yaw(2.0 * M_PI / 180.0);
+  const Eigen::Isometry3d moved = test::translation(Eigen::Vector3d(40, -7, 3)) * test::yaw(1.1);
+  std::vector<Eigen::Isometry3d> truth_elsewhere;
+  for (const Eigen::Isometry3d& pose : ground_truth) truth_elsewhere.push_back(moved * pose);
+  EXPECT_NEAR(poseErrorFromFirst(truth_elsewhere, estimate, 1).translation_m, 0.0, 1e-9);
+  const PoseError error = poseErrorFromFirst(truth_elsewhere, estimate, 10);
+  EXPECT_NEAR(error.translation_m, 0.3, 1e-9);
+  EXPECT_NEAR(error.rotation_deg, 2.0, 1e-6);
+  EXPECT_THROW(poseErrorFromFirst(ground_truth, estimate, 20), std::invalid_argument);
+}
+
 // The reverse run of a perfect odometry: scan n-1-j in scan n-1's frame.
 std::vector<Eigen::Isometry3d> exactReverse(const std::vector<Eigen::Isometry3d>& forward) {
   std::vector<Eigen::Isometry3d> reverse;

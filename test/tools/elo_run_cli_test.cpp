@@ -3,7 +3,7 @@
 // --strict stops at such a scan with a non-zero exit, after writing the poses of the scans before it.
 // --no-prefetch changes no pose. The same drive as a ROS 1 bag (kitti_to_bag) and a ROS 2 bag (our test
 // writer) gives the directory's poses bit for bit; malformed, truncated and empty bags are clear errors or
-// counted skips that keep the poses computed so far.
+// counted skips that keep the poses computed so far. --start plays from a later scan.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -186,6 +186,38 @@ TEST_F(EloRunCli, PrefetchingChangesNoPose) {
   const std::vector<std::string> written = lines(poses());
   EXPECT_EQ(written.size(), kScans);
   EXPECT_EQ(lines(directory_.file("prefetched.txt")), written);
+}
+
+// The TUM trajectory's stamps (first column) are those of `scans`: the run played them.
+void expectPlayedScans(const std::string& tum, const elo::Sequence& sequence, const std::vector<size_t>& scans) {
+  const std::vector<std::string> written = lines(tum);
+  ASSERT_EQ(written.size(), scans.size());
+  for (size_t i = 0; i < scans.size(); ++i) EXPECT_NEAR(std::stod(written[i]), sequence.stamp(scans[i]), 1e-6) << i;
+}
+
+// --start N plays scan N first, at the origin, then every --stride-th scan after it, at most --frames of
+// them: a bag cut mid-drive, or a node started on a moving car.
+TEST_F(EloRunCli, StartPlaysFromTheGivenScanWithStrideAndFrames) {
+  const elo::Sequence sequence(sequence_.string());
+  const CommandResult cut = runEloRun("--start 2 --frames 3 --tum " + directory_.file("cut.tum"));
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), 3u);
+  EXPECT_EQ(written[0], intact_poses_[0]) << "the first played scan is at the origin";
+  expectPlayedScans(directory_.file("cut.tum"), sequence, {2, 3, 4});
+  const CommandResult strided = runEloRun("--start 1 --stride 2 --tum " + directory_.file("strided.tum"));
+  ASSERT_EQ(strided.exit_code, 0) << strided.output;
+  EXPECT_EQ(lines(poses()).size(), 3u);
+  expectPlayedScans(directory_.file("strided.tum"), sequence, {1, 3, 5});
+}
+
+TEST_F(EloRunCli, StartBeyondTheInputOrWithReverseIsAUsageError) {
+  const CommandResult beyond = runEloRun("--start 6");
+  EXPECT_EQ(beyond.exit_code, 2) << beyond.output;
+  EXPECT_TRUE(contains(beyond.output, "--start 6: the input has 6 scans")) << beyond.output;
+  const CommandResult reverse = runEloRun("--start 2 --reverse");
+  EXPECT_EQ(reverse.exit_code, 2) << reverse.output;
+  EXPECT_TRUE(contains(reverse.output, "--start and --reverse cannot be combined")) << reverse.output;
 }
 
 // kitti_to_bag's start time: the bag's header stamps are the sequence's times plus this.

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "elo/eval/error_breakdown.hpp"
 #include "elo/eval/kitti_metric.hpp"
 #include "elo/eval/trajectory_error.hpp"
 
@@ -17,17 +18,21 @@ struct TrajectoryEvaluation {
   double length_m = 0.0;  // ground-truth path length
   std::vector<SegmentError> segments;
   DriftError drift;
+  std::vector<SegmentComponents> components;  // of each segment
+  ErrorBreakdown breakdown;
   RelativePoseError rpe;
   AbsoluteTrajectoryError ate;
 };
 
-// Throws std::invalid_argument naming both counts when the trajectories have different lengths.
+// The KITTI metric over segments of `segment_lengths` (m). Throws std::invalid_argument naming both
+// counts when the trajectories have different lengths.
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
-                                        const std::vector<Eigen::Isometry3d>& estimate);
+                                        const std::vector<Eigen::Isometry3d>& estimate,
+                                        const std::vector<double>& segment_lengths = kittiSegmentLengths());
 
-// The figures over all sequences: KITTI drift over the segments of all of them (as the devkit pools),
-// RPE over all frame pairs and ATE over all frames (each sequence aligned on its own, so the pooled
-// `ate.alignment` is the identity).
+// The figures over all sequences: KITTI drift and its breakdown over the segments of all of them (as the
+// devkit pools), RPE over all frame pairs and ATE over all frames (each sequence aligned on its own, so
+// the pooled `ate.alignment` is the identity).
 TrajectoryEvaluation poolEvaluations(const std::string& name, const std::vector<TrajectoryEvaluation>& sequences);
 
 }  // namespace elo

@@ -1,6 +1,7 @@
 // The KITTI odometry benchmark metric, as the devkit's evaluate_odometry.cpp defines it: relative
 // errors of all segments of 100, 200, ..., 800 m of ground-truth path, starting at every 10th frame.
-// The devkit computes in float; this computes the same quantities in double.
+// The devkit computes in float; this computes the same quantities in double. Other segment lengths
+// (e.g. 10..100 m for drives shorter than 800 m) keep the devkit's rules.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -41,10 +42,11 @@ struct LengthDriftError {
 // Path length (m) travelled from frame 0 to each frame: the sum of distances between consecutive poses.
 std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& poses);
 
-// Every segment of `ground_truth` with its error in `estimate`. Throws std::invalid_argument naming
-// both counts when the trajectories have different lengths.
+// Every segment of `ground_truth` of each of `lengths` (m) with its error in `estimate`. Throws
+// std::invalid_argument naming both counts when the trajectories have different lengths.
 std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
-                                             const std::vector<Eigen::Isometry3d>& estimate);
+                                             const std::vector<Eigen::Isometry3d>& estimate,
+                                             const std::vector<double>& lengths = kittiSegmentLengths());
 
 // The mean over `segments`; the devkit's overall figure pools the segments of all sequences this way.
 DriftError averageDrift(const std::vector<SegmentError>& segments);

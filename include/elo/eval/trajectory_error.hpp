@@ -1,5 +1,6 @@
 // Trajectory errors beside the KITTI metric: relative pose error between consecutive frames, absolute
-// trajectory error after a rigid alignment, and, without ground truth, the gap between a drive run
+// trajectory error after a rigid alignment, the error of one pose relative to the first, and, without
+// ground truth, the gap between a drive run
 // forward and in reverse.
 #pragma once
 
@@ -31,6 +32,18 @@ RelativePoseError relativePoseError(const std::vector<Eigen::Isometry3d>& ground
 // relativePoseError.
 AbsoluteTrajectoryError absoluteTrajectoryError(const std::vector<Eigen::Isometry3d>& ground_truth,
                                                 const std::vector<Eigen::Isometry3d>& estimate);
+
+// The error of the estimate's pose `frame` in the frame of its first pose, against the ground truth's in
+// the frame of its own first: inv(gt_0^-1 gt_frame) * (est_0^-1 est_frame). What a run started at any
+// scan (elo_run --start), a car already moving, gets wrong in its first scans (docs/real_drives.md).
+struct PoseError {
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+};
+
+// Throws std::invalid_argument when either trajectory has no pose `frame`.
+PoseError poseErrorFromFirst(const std::vector<Eigen::Isometry3d>& ground_truth,
+                             const std::vector<Eigen::Isometry3d>& estimate, size_t frame);
 
 // How far a drive run forward and the same scans run in reverse fail to close: `forward[i]` is scan i
 // in scan 0's frame, `reverse[j]` scan n-1-j in scan n-1's frame, so forward.back() * reverse.back() is

@@ -1,0 +1,164 @@
+// The real KITTI-raw drives with ground truth (docs/real_drives.md), the project's yardstick: ELO with
+// config/kitti.yaml over each drive stays within a little of today's drift over 10-100 m segments, and a
+// run started on a moving car is close to the truth from its first scans. The drives are not in the
+// repository (KITTI is CC BY-NC-SA): they are read from $ELO_REAL_DRIVES, else from the CMake cache path
+// ELO_REAL_DRIVES (default ../real_drives beside the source), and each test skips, saying where it
+// looked, when its drive is absent.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <algorithm>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "elo/eval/kitti_metric.hpp"
+#include "elo/eval/trajectory_error.hpp"
+#include "elo/io/config_yaml.hpp"
+#include "elo/io/sequence.hpp"
+#include "elo/odometry.hpp"
+
+namespace elo {
+namespace {
+
+const std::vector<double> kSegmentLengths = {10, 20, 50, 100};
+
+std::string drivesDirectory() {
+  const char* from_environment = std::getenv("ELO_REAL_DRIVES");
+  return from_environment != nullptr ? from_environment : ELO_REAL_DRIVES;
+}
+
+std::string drivePath(const std::string& drive) { return drivesDirectory() + "/" + drive; }
+
+bool driveIsPresent(const std::string& drive) {
+  return std::filesystem::is_directory(drivePath(drive) + "/velodyne") &&
+         std::filesystem::is_regular_file(drivePath(drive) + "/poses.txt");
+}
+
+std::string absentMessage(const std::string& drive) {
+  return "real drive " + drive + " not found under " + drivesDirectory() +
+         " (set ELO_REAL_DRIVES; how to get the drives: docs/real_drives.md)";
+}
+
+// ELO as elo_run --config config/kitti.yaml --threads 2 runs it, over `frames` scans from `start` (all
+// from there with 0), the first at the origin.
+std::vector<Eigen::Isometry3d> runDrive(const Sequence& sequence, size_t start, size_t frames) {
+  Config config;
+  loadConfigYaml(std::string(ELO_SOURCE_DIR) + "/config/kitti.yaml", config);
+  config.runtime.threads = 2;
+  Odometry odometry(config);
+  const size_t end = frames == 0 ? sequence.size() : std::min(sequence.size(), start + frames);
+  std::vector<Eigen::Isometry3d> poses;
+  for (size_t scan = start; scan < end; ++scan) {
+    const FrameResult result = odometry.process(sequence.load(scan));
+    EXPECT_TRUE(result.processed) << "scan " << scan << ": " << result.skip_reason;
+    poses.push_back(result.pose);
+  }
+  return poses;
+}
+
+// A run over the drive and its ground truth from the run's first scan, as many poses as the run has.
+struct DriveRun {
+  std::vector<Eigen::Isometry3d> ground_truth;
+  std::vector<Eigen::Isometry3d> estimate;
+};
+
+DriveRun runOf(const std::string& drive, size_t start, size_t frames) {
+  const Sequence sequence(drivePath(drive));
+  DriveRun run;
+  run.estimate = runDrive(sequence, start, frames);
+  const std::vector<Eigen::Isometry3d>& truth = sequence.groundTruth();
+  run.ground_truth.assign(truth.begin() + static_cast<std::ptrdiff_t>(start),
+                          truth.begin() + static_cast<std::ptrdiff_t>(start + run.estimate.size()));
+  return run;
+}
+
+// The whole runs made so far in this process, by drive: each drive is run whole once per test binary.
+std::map<std::string, DriveRun>& wholeRuns() {
+  static std::map<std::string, DriveRun> runs;
+  return runs;
+}
+
+const DriveRun& wholeDrive(const std::string& drive) {
+  const auto found = wholeRuns().find(drive);
+  if (found != wholeRuns().end()) return found->second;
+  return wholeRuns().emplace(drive, runOf(drive, 0, 0)).first->second;
+}
+
+// `frames` scans from `start`: from the whole run when it started there and was made already (the
+// odometry is causal, so its first poses are those of a shorter run), else a run of their own (ctest runs
+// each test in a process of its own).
+DriveRun firstScans(const std::string& drive, size_t start, size_t frames) {
+  const auto whole = wholeRuns().find(drive);
+  if (start != 0 || whole == wholeRuns().end()) return runOf(drive, start, frames);
+  DriveRun run = whole->second;
+  run.ground_truth.resize(std::min(frames, run.ground_truth.size()));
+  run.estimate.resize(run.ground_truth.size());
+  return run;
+}
+
+// Today's figures (config/kitti.yaml, frame-to-model, segments of 10-100 m starting every 10th frame);
+// the gate lets them grow by 15 % before it fails.
+struct DriftCase {
+  const char* drive;
+  double t_rel_percent;
+  double r_rel_deg_per_100m;
+};
+constexpr double kHeadroom = 1.15;
+
+void PrintTo(const DriftCase& today, std::ostream* out) { *out << "drive " << today.drive; }
+
+class RealDriveDrift : public testing::TestWithParam<DriftCase> {};
+
+TEST_P(RealDriveDrift, StaysWithinTodaysFigures) {
+  const DriftCase& today = GetParam();
+  if (!driveIsPresent(today.drive)) GTEST_SKIP() << absentMessage(today.drive);
+  const DriveRun& run = wholeDrive(today.drive);
+  const DriftError drift = averageDrift(kittiSegmentErrors(run.ground_truth, run.estimate, kSegmentLengths));
+  std::cout << "drive " << today.drive << ": t_rel " << drift.t_rel_percent << " %, r_rel "
+            << drift.r_rel_deg_per_100m << " deg/100m over " << drift.segments << " segments" << std::endl;
+  EXPECT_LT(drift.t_rel_percent, kHeadroom * today.t_rel_percent);
+  EXPECT_LT(drift.r_rel_deg_per_100m, kHeadroom * today.r_rel_deg_per_100m);
+}
+
+INSTANTIATE_TEST_SUITE_P(Drives, RealDriveDrift,
+                         testing::Values(DriftCase{"0001", 0.512, 0.498}, DriftCase{"0005", 5.048, 1.363},
+                                         DriftCase{"0027", 1.646, 0.692}),
+                         [](const auto& info) { return std::string("drive_") + info.param.drive; });
+
+// A run started on a moving car: ELO at its first scan knows nothing of the motion, yet its 2nd scan
+// must be within 0.10 m of the truth (relative to the 1st) and its 11th within 0.30 m.
+struct StartCase {
+  const char* drive;
+  size_t start;
+};
+constexpr size_t kStartFrames = 11;
+
+void PrintTo(const StartCase& start, std::ostream* out) { *out << "drive " << start.drive << " from scan " << start.start; }
+
+class StartInMotion : public testing::TestWithParam<StartCase> {};
+
+TEST_P(StartInMotion, FirstScansFollowTheTruth) {
+  const StartCase& start = GetParam();
+  if (!driveIsPresent(start.drive)) GTEST_SKIP() << absentMessage(start.drive);
+  const DriveRun run = firstScans(start.drive, start.start, kStartFrames);
+  ASSERT_GE(run.estimate.size(), kStartFrames);
+  const PoseError second = poseErrorFromFirst(run.ground_truth, run.estimate, 1);
+  const PoseError eleventh = poseErrorFromFirst(run.ground_truth, run.estimate, kStartFrames - 1);
+  std::cout << "drive " << start.drive << " from scan " << start.start << ": 2nd scan " << second.translation_m
+            << " m, 11th " << eleventh.translation_m << " m off" << std::endl;
+  EXPECT_LT(second.translation_m, 0.10);
+  EXPECT_LT(eleventh.translation_m, 0.30);
+}
+
+INSTANTIATE_TEST_SUITE_P(Drives, StartInMotion,
+                         testing::Values(StartCase{"0027", 0}, StartCase{"0027", 60}, StartCase{"0001", 0},
+                                         StartCase{"0005", 0}),
+                         [](const auto& info) {
+                           return std::string("drive_") + info.param.drive + "_scan_" + std::to_string(info.param.start);
+                         });
+
+}  // namespace
+}  // namespace elo

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Accuracy on the real KITTI-raw drives with ground truth (issue 43, docs/real_drives.md): every drive
+# under DRIVES_DIR (a subdirectory with velodyne/ and poses.txt, as tools/xviz_to_kitti.py writes it) is
+# run with config/kitti.yaml and scored over segments of 10-100 m. Prints two tables:
+#   - per drive: scans, length, t_rel, r_rel, t_rel_xy, ATE and the error breakdown (elo_eval
+#     --breakdown: heading, pitch, roll in deg/100 m; along-track, signed, cross-track and height in %);
+#     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's row;
+#   - start in motion: runs of 11 scans started at scan 0, every 60th scan and the scan where the car is
+#     fastest (oxts.txt), each scored by the error of its 2nd and 11th pose against the ground truth
+#     rebased to its first scan (elo_eval --start S --pose-errors 1,10).
+# Usage:
+#   tools/accuracy_real.sh BUILD_DIR DRIVES_DIR [f2m|f2f]
+# Works in BUILD_DIR/accuracy_real/ (trajectories kept); the tables are also written to
+# BUILD_DIR/accuracy_real/table.txt. Exits 0, saying where it looked, when DRIVES_DIR holds no drive.
+set -euo pipefail
+build=${1:-build}
+drives_dir=${2:-../real_drives}
+mode=${3:-f2m}
+bin="$build/devel/lib/elo_odometry"
+config="$(dirname "$0")/../config/kitti.yaml"
+work="$build/accuracy_real"
+segments=10,20,50,100
+start_every=60
+start_frames=11
+threads=${THREADS:-2}
+
+drives=()
+for dir in "$drives_dir"/*/; do
+  [ -d "$dir/velodyne" ] && [ -f "$dir/poses.txt" ] && drives+=("${dir%/}")
+done
+if [ ${#drives[@]} -eq 0 ]; then
+  echo "no real drives under $drives_dir: see docs/real_drives.md"
+  exit 0
+fi
+for tool in elo_run elo_eval; do
+  [ -x "$bin/$tool" ] || { echo "accuracy_real: $bin/$tool is missing; build first (make build)" >&2; exit 1; }
+done
+rm -rf "$work"
+mkdir -p "$work"
+table="$work/table.txt"
+: >"$table"
+
+# score DRIVE METHOD POSES: one row of the drive table, from elo_eval's KITTI row and breakdown row.
+score() {
+  local drive=$1 method=$2 poses=$3
+  "$bin/elo_eval" --gt "$drive/poses.txt" --est "$poses" --segments "$segments" --breakdown |
+    awk -v d="$(basename "$drive")" -v m="$method" '
+      $1 == "sequence" { table++; next }
+      table == 1 { scans = $2; length_m = $3; t = $4; r = $5; ate = $8; txy = $9 }
+      table == 2 { printf "%-6s %-7s %6d %9.1f %8.3f %15.3f %8.3f %7.3f %9.3f %7.3f %7.3f %+8.3f %8.3f %9.3f\n",
+                          d, m, scans, length_m, t, r, txy, ate, $2, $3, $4, $5, $6, $7 }' |
+    tee -a "$table"
+}
+
+printf '%-6s %-7s %6s %9s %8s %15s %8s %7s %9s %7s %7s %8s %8s %9s\n' drive method scans length_m 't_rel_%' \
+  'r_rel_deg/100m' 't_xy_%' ATE_m heading pitch roll 'along_%' 'cross_%' 'height_%' | tee -a "$table"
+for drive in "${drives[@]}"; do
+  name=$(basename "$drive")
+  "$bin/elo_run" --input "$drive" --output "$work/$name.txt" --config "$config" --mode "$mode" \
+    --threads "$threads" --quiet >"$work/$name.log"
+  score "$drive" "elo-$mode" "$work/$name.txt"
+  if [ -n "${KISS_RUN:-}" ]; then
+    "$KISS_RUN" "$drive/velodyne" --output "$work/${name}_kiss.txt" --threads "$threads" >"$work/${name}_kiss.log"
+    score "$drive" kiss-icp "$work/${name}_kiss.txt"
+  fi
+done
+echo "(segments of $segments m starting every 10th scan; heading, pitch, roll in deg/100m, mean absolute;" \
+  "along-track signed: + the estimate travels too far)" | tee -a "$table"
+
+# starts DRIVE SCANS: scan 0, every 60th scan, and the scan where the car is fastest, of those followed
+# by 10 more scans.
+starts() {
+  local drive=$1 scans=$2 last=$(($2 - start_frames)) s
+  for ((s = 0; s <= last; s += start_every)); do echo "$s"; done
+  if [ -f "$drive/oxts.txt" ]; then
+    awk -v last="$last" 'NR - 1 <= last && (best == "" || $7 > fastest) { fastest = $7; best = NR - 1 }
+                         END { if (best != "") print best }' "$drive/oxts.txt"
+  fi
+}
+
+printf '\n%-6s %7s %9s %15s %16s\n' drive start 'speed_m/s' '2nd_scan_err_m' '11th_scan_err_m' | tee -a "$table"
+for drive in "${drives[@]}"; do
+  name=$(basename "$drive")
+  scans=$(find "$drive/velodyne" -name '*.bin' | wc -l)
+  for start in $(starts "$drive" "$scans" | sort -nu); do
+    poses="$work/${name}_start_$start.txt"
+    "$bin/elo_run" --input "$drive" --output "$poses" --config "$config" --mode "$mode" --threads "$threads" \
+      --quiet --start "$start" --frames "$start_frames" >"$work/${name}_start_$start.log"
+    speed=$( [ -f "$drive/oxts.txt" ] && awk -v s="$start" 'NR - 1 == s { print $7 }' "$drive/oxts.txt" || echo nan)
+    "$bin/elo_eval" --gt "$drive/poses.txt" --est "$poses" --start "$start" --pose-errors 1,$((start_frames - 1)) |
+      awk -v d="$name" -v s="$start" -v v="$speed" '
+        $2 == "pose" { table = 1; next }
+        table && $2 == 1 { second = $3 }
+        table && $2 > 1 { printf "%-6s %7d %9.1f %15.3f %16.3f\n", d, s, v, second, $3 }' |
+      tee -a "$table"
+  done
+done
+echo "(error: translation of (gt_S^-1 gt_S+k)^-1 (est_0^-1 est_k), k = 1 and $((start_frames - 1)))" | tee -a "$table"
