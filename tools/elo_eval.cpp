@@ -26,7 +26,7 @@ namespace {
 constexpr int kExitBadInput = 2;
 
 const char* const kUsage =
-    "usage: elo_eval --gt GT --est EST [--segments L,...] [--breakdown] [--start S] [--pose-errors K,...]\n"
+    "usage: elo_eval --gt GT --est EST [--segments L,...] [--segment-step N] [--breakdown] [--start S] [--pose-errors K,...]\n"
     "                [--plot PNG] [--tum]\n"
     "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
     "       elo_eval --est EST --reverse REV\n"
@@ -46,8 +46,10 @@ const char* const kUsage =
     "  --tum        the files are TUM trajectories (t x y z qx qy qz qw) instead of KITTI poses\n"
     "  --segments L,...\n"
     "               the segment lengths in metres (default the devkit's 100,200,...,800); short drives are\n"
-    "               scored with --segments 10,20,50,100 (docs/real_drives.md); segments still start every\n"
-    "               10th frame\n"
+    "               scored with --segments 10,20,50,100 (docs/real_drives.md)\n"
+    "  --segment-step N\n"
+    "               frames between segment starts (default the devkit's 10); 1 starts a segment at every\n"
+    "               frame, as the short real drives are scored\n"
     "  --breakdown  also print each sequence's segment error split into what is wrong: heading, pitch and\n"
     "               roll (deg/100m, mean absolute), along-track (%, signed: + when the estimate travels too\n"
     "               far, a scale error), cross-track and height (%, mean absolute), in the frame of each\n"
@@ -78,6 +80,7 @@ struct Options {
   std::optional<std::string> reverse;
   bool tum = false;
   std::vector<double> segment_lengths = elo::kittiSegmentLengths();
+  size_t segment_step = elo::kKittiStartFrameStep;
   bool breakdown = false;
   std::optional<size_t> start;  // --start: the estimate covers the ground truth from this pose on
   std::vector<size_t> pose_errors;
@@ -107,6 +110,9 @@ Options parseArguments(int argc, char** argv) {
       if (std::any_of(options.segment_lengths.begin(), options.segment_lengths.end(), not_positive)) {
         throw UsageError("--segments expects lengths above 0 m");
       }
+    } else if (arguments.is("--segment-step")) {
+      options.segment_step = arguments.number<size_t>();
+      if (options.segment_step == 0) throw UsageError("--segment-step must be at least 1");
     } else if (arguments.is("--breakdown")) {
       options.breakdown = true;
     } else if (arguments.is("--start")) {
@@ -234,7 +240,8 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
   if (options.start) ground_truth = groundTruthFrom(ground_truth, *options.start, estimate.size(), files.ground_truth);
   elo::TrajectoryEvaluation evaluation;
   try {
-    evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate, options.segment_lengths);
+    evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate, options.segment_lengths,
+                                            options.segment_step);
     for (size_t pose : options.pose_errors) {
       pose_errors.push_back({files.name, pose, elo::poseErrorFromFirst(ground_truth, estimate, pose)});
     }

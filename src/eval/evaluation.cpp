@@ -25,10 +25,10 @@ double pooledRmse(const std::vector<Part>& parts, Rmse rmse_of, Count count_of) 
 
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
                                         const std::vector<Eigen::Isometry3d>& estimate,
-                                        const std::vector<double>& segment_lengths) {
+                                        const std::vector<double>& segment_lengths, size_t start_step) {
   TrajectoryEvaluation evaluation;
   evaluation.name = name;
-  evaluation.segments = kittiSegmentErrors(ground_truth, estimate, segment_lengths);
+  evaluation.segments = kittiSegmentErrors(ground_truth, estimate, segment_lengths, start_step);
   evaluation.frames = ground_truth.size();
   const std::vector<double> distances = trajectoryDistances(ground_truth);
   evaluation.length_m = distances.empty() ? 0.0 : distances.back();

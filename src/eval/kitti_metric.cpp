@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 #include "relative_motion.hpp"
 
@@ -50,11 +51,12 @@ std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& po
 
 std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
                                              const std::vector<Eigen::Isometry3d>& estimate,
-                                             const std::vector<double>& lengths) {
+                                             const std::vector<double>& lengths, size_t start_step) {
   eval_detail::requireSameLength(ground_truth, estimate);
+  if (start_step == 0) throw std::invalid_argument("segments must start at least one frame apart");
   const std::vector<double> distances = trajectoryDistances(ground_truth);
   std::vector<SegmentError> segments;
-  for (size_t first = 0; first < ground_truth.size(); first += kKittiStartFrameStep) {
+  for (size_t first = 0; first < ground_truth.size(); first += start_step) {
     for (double length : lengths) {
       const std::optional<size_t> last = lastFrameOfSegment(distances, first, length);
       if (!last) {

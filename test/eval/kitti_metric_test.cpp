@@ -66,6 +66,17 @@ TEST(KittiMetric, SegmentLengthsAreTheCallersChoice) {
   EXPECT_NEAR(by_length[0].error.t_rel_percent, 1.0, 1e-6);
 }
 
+// A short drive is scored with a segment starting at every frame (elo_eval --segment-step 1).
+TEST(KittiMetric, SegmentStartsAreTheCallersChoice) {
+  const std::vector<Eigen::Isometry3d> ground_truth = test::straightLine(kFrames, kSpacing);
+  const std::vector<SegmentError> segments =
+      kittiSegmentErrors(ground_truth, test::scaleIncrements(ground_truth, 1.01), {10}, 1);
+  ASSERT_EQ(segments.size(), kFrames - 10);
+  for (size_t i = 0; i < segments.size(); ++i) EXPECT_EQ(segments[i].first_frame, i);
+  EXPECT_NEAR(averageDrift(segments).t_rel_percent, 1.0, 1e-6);
+  EXPECT_THROW(kittiSegmentErrors(ground_truth, ground_truth, {10}, 0), std::invalid_argument);
+}
+
 TEST(KittiMetric, ScaledIncrementsOnAStraightLineGiveOnePercent) {
   const std::vector<Eigen::Isometry3d> ground_truth = test::straightLine(kFrames, kSpacing);
   const std::vector<SegmentError> segments =

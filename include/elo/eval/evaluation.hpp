@@ -24,11 +24,12 @@ struct TrajectoryEvaluation {
   AbsoluteTrajectoryError ate;
 };
 
-// The KITTI metric over segments of `segment_lengths` (m). Throws std::invalid_argument naming both
-// counts when the trajectories have different lengths.
+// The KITTI metric over segments of `segment_lengths` (m) starting every `start_step` frames. Throws
+// std::invalid_argument naming both counts when the trajectories have different lengths.
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
                                         const std::vector<Eigen::Isometry3d>& estimate,
-                                        const std::vector<double>& segment_lengths = kittiSegmentLengths());
+                                        const std::vector<double>& segment_lengths = kittiSegmentLengths(),
+                                        size_t start_step = kKittiStartFrameStep);
 
 // The figures over all sequences: KITTI drift and its breakdown over the segments of all of them (as the
 // devkit pools), RPE over all frame pairs and ATE over all frames (each sequence aligned on its own, so

@@ -42,11 +42,13 @@ struct LengthDriftError {
 // Path length (m) travelled from frame 0 to each frame: the sum of distances between consecutive poses.
 std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& poses);
 
-// Every segment of `ground_truth` of each of `lengths` (m) with its error in `estimate`. Throws
-// std::invalid_argument naming both counts when the trajectories have different lengths.
+// Every segment of `ground_truth` of each of `lengths` (m), starting every `start_step` frames, with its
+// error in `estimate`. Throws std::invalid_argument naming both counts when the trajectories have
+// different lengths.
 std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d>& ground_truth,
                                              const std::vector<Eigen::Isometry3d>& estimate,
-                                             const std::vector<double>& lengths = kittiSegmentLengths());
+                                             const std::vector<double>& lengths = kittiSegmentLengths(),
+                                             size_t start_step = kKittiStartFrameStep);
 
 // The mean over `segments`; the devkit's overall figure pools the segments of all sequences this way.
 DriftError averageDrift(const std::vector<SegmentError>& segments);
