@@ -14,8 +14,8 @@ namespace {
 // bring a candidate within about half a step of the motion to within centimetres of it, while one farther
 // off stays where the surfaces facing the motion do not fit.
 constexpr int kCandidateIterations = 3;
-// Candidates along x either way at most: a scan long after the model's (dropped scans right after a
-// start) is searched over this many steps, not over its whole max_speed * dt.
+// Candidates either way at most, along x and in yaw: a scan long after the model's (dropped scans right
+// after a start) is searched over this many steps, not over its whole max_speed * dt.
 constexpr int kMaxStepsEachWay = 20;
 
 struct Candidate {
@@ -86,12 +86,14 @@ StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& c
   const auto start = Clock::now();
   const StartSearchConfig& search = config.start_search;
   const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * dt;
-  // Along x first, then in yaw around the candidate that started nearest the best along x: a turn
-  // within the search's yaw reach hardly moves where the scan fits along x (so the two are searched
-  // one after the other, not on a grid of their product, at a third of its cost).
+  // Along x first, then in yaw around where the best along x started: a turn within the search's yaw
+  // reach hardly moves where the scan fits along x, so the two are searched one after the other rather
+  // than on a grid of both, at a third of its cost.
   std::vector<Candidate> scored;
   const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(search.max_speed * dt, search);
-  for (const Eigen::Isometry3d& motion : along_x) scored.push_back(registerCandidate(backend, motion, config.registration));
+  for (const Eigen::Isometry3d& motion : along_x) {
+    scored.push_back(registerCandidate(backend, motion, config.registration));
+  }
   const auto better = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
   const size_t best_along_x = std::min_element(scored.begin(), scored.end(), better) - scored.begin();
   for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x], yaw_reach, search)) {
