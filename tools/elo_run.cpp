@@ -247,6 +247,19 @@ class Report {
   void addReading(double milliseconds) { reading_.push_back(milliseconds); }
   double meanTotalMilliseconds() const { return summarise(total_).mean; }
 
+  // Refused registrations by reason, recoveries, restarts, and whether the run ended lost.
+  static void printTrackingHealth(const elo::Odometry& odometry) {
+    for (const auto& [reason, count] : odometry.refusalCounts()) {
+      std::printf(", %zu registration%s refused (%s)", count, count > 1 ? "s" : "", reason.c_str());
+    }
+    if (odometry.recoveryCount() > 0) std::printf(", %zu recovered", odometry.recoveryCount());
+    if (odometry.trackingRestartCount() > 0) {
+      std::printf(", %zu model restart%s after refusals in a row", odometry.trackingRestartCount(),
+                  odometry.trackingRestartCount() > 1 ? "s" : "");
+    }
+    if (odometry.lost()) std::printf(", LOST at the end (the last registration was refused)");
+  }
+
   void print(elo::Odometry& odometry, size_t scans, size_t non_finite_points, double wall_seconds) const {
     if (non_finite_points > 0) std::printf("non-finite points skipped while reading: %zu\n", non_finite_points);
     std::printf("\nframes: %zu scans, %zu processed", scans, odometry.processedCount());
@@ -268,6 +281,7 @@ class Report {
         std::printf(" (%zu ambiguous: another motion fit about as well)", odometry.ambiguousStartCount());
       }
     }
+    printTrackingHealth(odometry);
     if (odometry.sensorMisfitCount() > 0) {
       std::printf(", %zu not fitting the sensor model (the warning above)", odometry.sensorMisfitCount());
     }
@@ -364,7 +378,7 @@ class MapOutput {
 
   void add(elo::Odometry& odometry, const elo::FrameResult& result, const elo::PointCloud& cloud) {
     if (result.reset) builder_.clear();  // the poses before the reset lie in another frame
-    if (!result.processed) return;
+    if (!result.processed || !result.refusal.empty()) return;  // a refused scan's pose is the prior's
     ++processed_;
     if (result.registration.degeneracy.any()) {
       ++degenerate_;
@@ -485,6 +499,14 @@ class ScanLoop {
     if (!result.sensor_warning.empty() && odometry_.sensorMisfitCount() == 1) {  // the first; the summary counts them
       std::fprintf(stderr, "\nscan %zu: warning: %s\n", scan, result.sensor_warning.c_str());
     }
+    if (!result.sensor_height_warning.empty()) {
+      std::fprintf(stderr, "\nscan %zu: warning: %s\n", scan, result.sensor_height_warning.c_str());
+    }
+    if (!result.refusal.empty()) {
+      std::fprintf(stderr, "\nscan %zu: registration refused (%s)%s\n", scan, result.refusal.c_str(),
+                   result.tracking_restart ? "; model restarted from this scan" : "");
+    }
+    if (result.recovered) std::fprintf(stderr, "\nscan %zu: tracking recovered\n", scan);
     if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
     if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
     if (result.gap_restart) {

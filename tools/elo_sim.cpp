@@ -83,6 +83,11 @@ std::string usage() {
          "  --mirror 0|1         1: the drive in the world's mirror image (y -> -y; the sensor turns the\n"
          "                       other way), left turns made right ones (default 0); not with\n"
          "                       --time-convention azimuth\n"
+         "  --gait " + joined(elo::sim::gaitNames()) + "\n"
+         "                       how the sensor moves about the path (elo/sim/gait.hpp): walk, carried by\n"
+         "                       hand (swung +-30 deg at 1 Hz, rocked +-10 deg, bobbing 4 cm at 1.8 steps\n"
+         "                       a second); trot, on a legged robot (jolts of 3 cm and 4 deg at 3 footfalls\n"
+         "                       a second); default none (a vehicle)\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -108,7 +113,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
       "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
-      "--mirror"};
+      "--mirror", "--gait"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -219,6 +224,11 @@ Options parseOptions(int argc, char** argv) {
   if (const auto mirror = take("--mirror")) {
     if (*mirror != "0" && *mirror != "1") throw UsageError("--mirror expects 0 or 1");
     spec.mirrored = *mirror == "1";
+  }
+  if (const auto gait = take("--gait")) {
+    const std::optional<elo::sim::Gait> named = elo::sim::gaitFromName(*gait);
+    if (!named) throw UsageError("--gait expects " + joined(elo::sim::gaitNames()) + ", got '" + *gait + "'");
+    spec.gait = *named;
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;

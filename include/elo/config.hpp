@@ -216,15 +216,40 @@ struct LocalizationConfig {
   double search_margin = 0.05;
 };
 
+// What the platform can do (docs/robustness.md#a-lost-track): a registration that moves the sensor
+// faster, turns it faster or changes its velocity more than this between two scans, or whose
+// correspondences collapse against the scans before, is refused: its pose is the motion prior's, it
+// updates neither the model nor the velocity, and the next scan's motion is searched as at a start.
+// Carried by hand, the odometry had accepted motions of kilometres a second that became the next scan's
+// prior; the defaults fit cars (144 km/h, 0.8 g braking) and hand-held rigs (swung at 200 deg/s).
+struct MotionConfig {
+  double max_speed = 40.0;           // m/s; also the start search's reach along x
+  double max_turn_rate_deg = 360.0;  // deg/s
+  // m/s^2: the change of velocity from one registration to the next over their interval. 2 g: a car
+  // brakes at 0.8 g, a walker's step and a trot's shocks stay under 1.5 g; a wrong registration on a
+  // hand-held walk jumps by metres a scan (tens of g).
+  double max_acceleration = 20.0;
+  // s: how far a scan's stamp may lie from when it was taken. A velocity is a registered motion over
+  // the stamps' interval, so a stamp error of e makes two consecutive velocities differ by up to
+  // 2 e / dt of the speed without any acceleration: tolerated on top of max_acceleration. KITTI-raw
+  // drives' times come rounded to 10 ms (0.10 and 0.11 s between scans): at 17 m/s that is 3.4 m/s.
+  double stamp_jitter = 0.01;
+  // A registration with fewer non-ground inliers than this share of the median of the last accepted
+  // ones has lost the scene (a scan of another place, a blocked view).
+  double min_inlier_share_of_recent = 0.3;
+  // Refused registrations in a row after which the model restarts from the scan at hand, at the pose the
+  // motion prior gives it: the old model no longer matches what the sensor sees.
+  int restart_after = 5;
+};
+
 // The start in motion (docs/start_in_motion.md): a scan registered when no motion is known yet (the first
 // registration after a start, a reset or a restart) has its motion searched for first, so that odometry
 // started on a moving vehicle tracks from its second scan. Candidates lie along the sensor's x axis,
 // forward and back, and in yaw; each is registered a few steps and scored by how well it fits.
 struct StartSearchConfig {
   bool enabled = true;
-  // m/s: the candidates along x reach max_speed times the time between the two scans either way: 4 m at
-  // 10 Hz, 144 km/h.
-  double max_speed = 40.0;
+  // The candidates along x reach motion.max_speed times the time between the two scans either way: 4 m
+  // at 10 Hz.
   double step = 1.0;  // m between candidates along x: a candidate half a step off converges in its few steps
   // deg/s: the candidates in yaw reach this times the time between the scans either way (3 deg at 10 Hz).
   double max_yaw_rate_deg = 30.0;
@@ -245,6 +270,7 @@ struct Config {
   MapConfig map;
   RuntimeConfig runtime;
   LocalizationConfig localization;
+  MotionConfig motion;
   StartSearchConfig start_search;
 };
 

@@ -26,6 +26,8 @@ class MotionModel {
   // Whether any increment was recorded since the last reset: before it the motion is unknown, not zero
   // (Odometry searches it: start_search.hpp).
   bool known() const { return history_ > 0; }
+  // The velocity of the increment recorded last, whatever the prior; zero before any.
+  const Vector6d& latestVelocity() const { return latest_velocity_; }
   // The velocity (twist per second) of the increment recorded last; zero before any. What a sweep is
   // deskewed under before it is registered: the constant-acceleration extrapolation doubles the noise of
   // the registrations it extrapolates, and the deskew feeds that noise back into the next registration

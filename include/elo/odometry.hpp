@@ -5,13 +5,17 @@
 #include <Eigen/Geometry>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "elo/backend.hpp"
 #include "elo/config.hpp"
+#include "elo/deskew.hpp"
 #include "elo/motion_prior.hpp"
 #include "elo/registration.hpp"
+#include "elo/sensor_height_check.hpp"
 #include "elo/start_search.hpp"
+#include "elo/tracking_guard.hpp"
 
 namespace elo {
 
@@ -38,6 +42,21 @@ struct FrameResult {
   // The start in motion: the search for the motion of a scan registered with none known (searched: the
   // first registration after a start, a reset or a restart, with start_search.enabled).
   StartSearchResult start_search;
+  // Tracking health (docs/robustness.md#a-lost-track). Why the registration was refused (a
+  // refusal:: reason of tracking_guard.hpp), empty when it was accepted. A refused scan is processed, but
+  // its pose is the motion prior's and it changed neither the model nor the velocity.
+  std::string refusal;
+  bool recovered = false;         // accepted after refused ones
+  // Its registration from the motion prior was refused, and the scan searched and registered again
+  // (start_search); `refusal` is then that of the second registration.
+  bool searched_after_refusal = false;
+  // motion.restart_after refusals in a row: the model restarted from this scan, at the refused pose.
+  bool tracking_restart = false;
+  // Deskewed under the last velocity the scan filled too few pixels; projected again without deskew.
+  bool projected_without_deskew = false;
+  // The ground the scans show lies far from ground.sensor_height (SensorHeightCheck::add()); empty when
+  // it does not, or was told already.
+  std::string sensor_height_warning;
   // Motion compensation (docs/deskew.md): where the points' times came from (none: the scan was taken as
   // instantaneous), the rounds of deskewing again with the registered motion, and why the cloud's own
   // times were not used or not all used (empty when they were, or when none were asked for).
@@ -95,6 +114,14 @@ class Odometry {
   // Start searches run (FrameResult::start_search), and those whose winner did not stand out.
   size_t startSearchCount() const { return start_searches_; }
   size_t ambiguousStartCount() const { return ambiguous_starts_; }
+  // Tracking health: refused registrations by reason, recoveries after them, model restarts after
+  // motion.restart_after refusals in a row, and whether the latest registration was refused (lost).
+  const std::map<std::string, size_t>& refusalCounts() const { return refusals_; }
+  size_t recoveryCount() const { return recoveries_; }
+  size_t trackingRestartCount() const { return tracking_restarts_; }
+  // The sensor's height above the ground the scans show (median of recent checks); nullopt before any.
+  std::optional<double> measuredSensorHeight() const { return height_check_.measured(); }
+  bool lost() const { return refused_in_row_ > 0; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -128,11 +155,39 @@ class Odometry {
   // once, for the model, after the registration converges (docs/deskew.md).
   // `deskewed`: the velocity the projection deskewed the scan under; returns the one it ends deskewed
   // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
-  Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed, double farthest,
-                             FrameResult& result);
+  // `informed`: the guess is the motion prior's, with enough history to trust (MotionModel::informed()).
+  Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, bool informed, double dt, const Vector6d& deskewed,
+                             double farthest, FrameResult& result);
+  // The registration from the motion prior was refused (a swing the prior could not follow): the scan,
+  // deskewed as it was projected (`projected_under`) again, has its motion searched as at a start and
+  // is registered from the winner; `result.refusal` becomes that registration's. Returns the velocity the
+  // scan ends deskewed under.
+  Vector6d searchAfterRefusal(double dt, const Vector6d& projected_under, const Vector6d& deskewed_under,
+                              double farthest, FrameResult& result);
   // The registration's initial guess: the motion prior's prediction, or where the start search puts the
   // scan when no motion is known yet (recorded in `result`).
   Eigen::Isometry3d initialGuess(double dt, FrameResult& result);
+  // The start search (start_search.hpp) for a scan whose motion is unknown: around the motion accepted
+  // last carried over `dt` when a refusal made the motion unknown (its reach along x spans a vehicle that
+  // stopped as well as one that drove on); around the identity at a start, when none was accepted.
+  StartSearchResult searchMotion(double dt);
+  // The velocity a scan is deskewed under before it is registered: the last registered (the motion
+  // prior's), or after a refusal the one accepted last; zero at a start and without a motion prior.
+  Vector6d sweepVelocityBeforeRegistration() const;
+  // Projects the cloud deskewed under `velocity`; when that fills too few pixels (a wrong velocity moves
+  // the points out of the image), projects it again as measured, saying so in `result`: a scan is then
+  // skipped for what it is, never for the odometry's own velocity. Returns the occupied pixels.
+  size_t projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
+                         FrameResult& result);
+  // Takes the scan's registration `reference_delta` (over `dt`, the scan deskewed under `deskewed_under`):
+  // the pose, the motion prior and the tracking guard move on. Returns the scan's stamp frame in its
+  // reference frame.
+  Eigen::Isometry3d acceptRegistration(const Eigen::Isometry3d& reference_delta, double dt,
+                                       const Vector6d& deskewed_under, const CloudTimes& times, FrameResult& result);
+  // Refuses the scan's registration (result.refusal): its pose is the last accepted velocity carried over
+  // `dt`, the motion becomes unknown (the next scan searches it). Returns true when the refusals in a row
+  // reached motion.restart_after: the model has been restarted at that pose, for the scan to start anew.
+  bool refuseRegistration(double dt, FrameResult& result);
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
   void deskewScanAgain(const Vector6d& velocity, FrameResult& result);
 
@@ -162,6 +217,15 @@ class Odometry {
   size_t sensor_misfits_ = 0;
   size_t start_searches_ = 0;
   size_t ambiguous_starts_ = 0;
+  TrackingGuard guard_;
+  SensorHeightCheck height_check_;
+  // The velocity of the last accepted registration (twist per second), which carries refused scans; kept
+  // when the motion becomes unknown for the search.
+  Vector6d held_velocity_ = Vector6d::Zero();
+  std::map<std::string, size_t> refusals_;
+  size_t refused_in_row_ = 0;
+  size_t recoveries_ = 0;
+  size_t tracking_restarts_ = 0;
 };
 
 }  // namespace elo

@@ -43,10 +43,13 @@ struct StartSearchResult {
 double fitScore(const NormalEquations& sums, const RegistrationConfig& config);
 
 // Searches the motion of the backend's projected scan against its model, `dt` seconds after the model's
-// scan: candidates every start_search.step metres along x within start_search.max_speed * dt either way,
+// scan: candidates every start_search.step metres along x within motion.max_speed * dt either way,
 // then at every yaw step within start_search.max_yaw_rate_deg * dt around the best of those, each
 // registered from a loose kernel for a few Gauss-Newton steps and scored by fitScore() under the final
 // kernel.
-StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config);
+// `centre`: the motion the candidates lie around; the identity at a start, the motion last accepted
+// carried over `dt` when the scan's registration from the prior was refused.
+StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
+                                    const Eigen::Isometry3d& centre = Eigen::Isometry3d::Identity());
 
 }  // namespace elo

@@ -223,10 +223,19 @@ std::vector<Parameter> parameters(Config& c) {
                 "best-scored search candidates registered to convergence"),
       bindField("localization.search_margin", c.localization.search_margin,
                 "inlier share by which a search's winner must beat a candidate that converged elsewhere"),
+      bindField("motion.max_speed", c.motion.max_speed,
+                "m/s: a registration moving the sensor faster is refused; the start search's reach along x"),
+      bindField("motion.max_turn_rate_deg", c.motion.max_turn_rate_deg, "deg/s: a registration turning faster is refused"),
+      bindField("motion.max_acceleration", c.motion.max_acceleration,
+                "m/s^2: a registration changing the velocity more than this over the scan interval is refused"),
+      bindField("motion.stamp_jitter", c.motion.stamp_jitter,
+                "s: error of a scan's stamp, whose effect on the velocity max_acceleration tolerates"),
+      bindField("motion.min_inlier_share_of_recent", c.motion.min_inlier_share_of_recent,
+                "a registration with fewer inliers than this share of the recent ones' median is refused"),
+      bindField("motion.restart_after", c.motion.restart_after,
+                "refused registrations in a row after which the model restarts from the scan at hand"),
       bindField("start_search.enabled", c.start_search.enabled,
                 "search the motion of a scan registered with none known (a start on a moving vehicle)"),
-      bindField("start_search.max_speed", c.start_search.max_speed,
-                "m/s: the start search's candidates reach this times the scan interval along x, either way"),
       bindField("start_search.step", c.start_search.step, "m between the start search's candidates along x"),
       bindField("start_search.max_yaw_rate_deg", c.start_search.max_yaw_rate_deg,
                 "deg/s: the start search's candidates reach this times the scan interval in yaw, either way"),
@@ -337,8 +346,15 @@ void validate(const Config& c) {
   validate(c.map);
   require(c.runtime.threads >= 0, "runtime.threads", "must not be negative");
   validateLocalization(c.localization);
+  const MotionConfig& motion = c.motion;
+  require(motion.max_speed > 0.0, "motion.max_speed", "must be positive");
+  require(motion.max_turn_rate_deg > 0.0, "motion.max_turn_rate_deg", "must be positive");
+  require(motion.max_acceleration > 0.0, "motion.max_acceleration", "must be positive");
+  require(motion.stamp_jitter >= 0.0, "motion.stamp_jitter", "must not be negative");
+  require(motion.min_inlier_share_of_recent >= 0.0 && motion.min_inlier_share_of_recent < 1.0,
+          "motion.min_inlier_share_of_recent", "must lie in [0, 1)");
+  require(motion.restart_after >= 1, "motion.restart_after", "must be at least 1");
   const StartSearchConfig& start = c.start_search;
-  require(start.max_speed >= 0.0, "start_search.max_speed", "must not be negative");
   require(start.step > 0.0, "start_search.step", "must be positive");
   require(start.max_yaw_rate_deg >= 0.0, "start_search.max_yaw_rate_deg", "must not be negative");
   require(start.yaw_step_deg > 0.0, "start_search.yaw_step_deg", "must be positive");

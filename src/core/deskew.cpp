@@ -61,4 +61,10 @@ Vector6d sweepVelocity(const Eigen::Isometry3d& increment, double dt) {
   return logSE3(increment) / dt;
 }
 
+double motionInterval(double stamp_interval, TimeSource source, const SensorConfig& sensor) {
+  if (source != TimeSource::azimuth) return stamp_interval;
+  const double period = 1.0 / sensor.rotation_rate_hz;
+  return std::max(1.0, std::round(stamp_interval / period)) * period;
+}
+
 }  // namespace elo

@@ -9,7 +9,11 @@
 
 namespace elo {
 
-Odometry::Odometry(const Config& config) : config_(config), motion_(config.model.motion_prior) {
+Odometry::Odometry(const Config& config)
+    : config_(config),
+      motion_(config.model.motion_prior),
+      guard_(config),
+      height_check_(config.ground.sensor_height) {
   validate(config_);
   backend_ = makeBackend(config_, &backend_warning_);
 }
@@ -17,6 +21,9 @@ Odometry::Odometry(const Config& config) : config_(config), motion_(config.model
 void Odometry::restartModel() {
   backend_->resetModel();
   motion_.reset();
+  guard_.reset();
+  held_velocity_.setZero();
+  refused_in_row_ = 0;
   started_ = false;
 }
 
@@ -58,6 +65,11 @@ std::string Odometry::sensorWarning(const PointCloud& cloud) {
   return warning;
 }
 
+// The sensor height is checked on each of the first scans, then on every 20th: a mount does not move,
+// but a warning at the start must not wait.
+constexpr size_t kSensorHeightChecksAtStart = 5;
+constexpr size_t kSensorHeightCheckPeriod = 20;
+
 FrameResult Odometry::skip(const std::string& reason) {
   ++skipped_[reason];
   FrameResult result;
@@ -75,8 +87,8 @@ void Odometry::deskewScanAgain(const Vector6d& velocity, FrameResult& result) {
   ++result.deskew_rounds;
 }
 
-Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, const Vector6d& deskewed,
-                                     double farthest, FrameResult& result) {
+Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool informed, double dt,
+                                     const Vector6d& deskewed, double farthest, FrameResult& result) {
   Vector6d deskewed_under = deskewed;
   const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& estimate, bool converged) {
     if (result.time_source == TimeSource::none) return false;
@@ -94,17 +106,95 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, double dt, 
     return !model_provisional_;
   };
   const auto stage_start = Clock::now();
-  result.registration = registerScan(*backend_, guess, motion_.informed(), config_.registration, deskew_again);
-  result.times.registration = millisecondsSince(stage_start) - result.times.deskew;
+  const double deskew_before = result.times.deskew;
+  result.registration = registerScan(*backend_, guess, informed, config_.registration, deskew_again);
+  result.times.registration += millisecondsSince(stage_start) - (result.times.deskew - deskew_before);
   return deskewed_under;
 }
 
 Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
   if (motion_.known() || !config_.start_search.enabled) return motion_.predict(dt);
-  result.start_search = searchStartMotion(*backend_, dt, config_);
+  result.start_search = searchMotion(dt);
   ++start_searches_;
   if (result.start_search.ambiguous) ++ambiguous_starts_;
   return result.start_search.motion;
+}
+
+size_t Odometry::projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
+                                 FrameResult& result) {
+  const size_t occupied = backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
+  if (occupied >= minOccupiedPixels() || velocity.isZero()) return occupied;
+  velocity.setZero();
+  result.projected_without_deskew = true;
+  return backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
+}
+
+Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& reference_delta, double dt,
+                                               const Vector6d& deskewed_under, const CloudTimes& times,
+                                               FrameResult& result) {
+  // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference` seconds
+  // before the reference instant) is exp(-reference * velocity) in the reference frame.
+  const Eigen::Isometry3d stamp_in_reference = expSE3(-times.reference * deskewed_under);
+  // The first scan of a start had no velocity to place its stamp in its sweep; registered against it as
+  // measured (bent alike), this scan measured the motion between like instants of the two sweeps.
+  if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
+  // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
+  result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
+  pose_ = pose_ * result.delta;
+  motion_.record(reference_delta, dt);
+  const Degeneracy& degeneracy = result.registration.degeneracy;
+  if (degeneracy.any()) ++degenerate_;
+  motion_.holdVelocityAlong(degeneracy.priorShare());
+  held_velocity_ = motion_.latestVelocity();
+  guard_.accept(result.registration, dt);
+  if (refused_in_row_ > 0) {
+    result.recovered = true;
+    ++recoveries_;
+    refused_in_row_ = 0;
+  }
+  return stamp_in_reference;
+}
+
+Vector6d Odometry::searchAfterRefusal(double dt, const Vector6d& projected_under, const Vector6d& deskewed_under,
+                                      double farthest, FrameResult& result) {
+  // The refused registration's motion may have deskewed the scan: back to how it was projected.
+  if (deskewed_under != projected_under) deskewScanAgain(projected_under, result);
+  result.deskew_rounds = 0;
+  result.start_search = searchMotion(dt);
+  ++start_searches_;
+  if (result.start_search.ambiguous) ++ambiguous_starts_;
+  result.searched_after_refusal = true;
+  const Vector6d searched_under =
+      registerAndDeskew(result.start_search.motion, false, dt, projected_under, farthest, result);
+  result.refusal = guard_.refusal(result.registration, dt);
+  return searched_under;
+}
+
+bool Odometry::refuseRegistration(double dt, FrameResult& result) {
+  ++refusals_[result.refusal];
+  ++refused_in_row_;
+  result.delta = expSE3(held_velocity_ * dt);
+  result.pose = pose_ * result.delta;
+  motion_.reset();
+  if (refused_in_row_ < static_cast<size_t>(config_.motion.restart_after)) return false;
+  // The model no longer matches what the sensor sees: start again from this scan, where the prior puts it.
+  const Vector6d held = held_velocity_;
+  restartModel();
+  held_velocity_ = held;
+  pose_ = result.pose;
+  stamp_in_reference_ = Eigen::Isometry3d::Identity();
+  result.tracking_restart = true;
+  ++tracking_restarts_;
+  return true;
+}
+
+StartSearchResult Odometry::searchMotion(double dt) {
+  return searchStartMotion(*backend_, dt, config_, expSE3(held_velocity_ * dt));
+}
+
+Vector6d Odometry::sweepVelocityBeforeRegistration() const {
+  if (config_.model.motion_prior == MotionPrior::none) return Vector6d::Zero();
+  return motion_.known() ? motion_.velocity() : held_velocity_;
 }
 
 FrameResult Odometry::process(const PointCloud& cloud) {
@@ -139,14 +229,19 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   result.points_without_time = times.outside_sweep;
   if (!times.warning.empty()) ++time_warnings_[times.warning];
   result.sensor_warning = sensorWarning(cloud);
+  // Each of the first scans, then every kSensorHeightCheckPeriod-th: about 0.3 ms a check.
+  if (processed_ < kSensorHeightChecksAtStart || processed_ % kSensorHeightCheckPeriod == 0) {
+    result.sensor_height_warning = height_check_.add(cloud);
+  }
   // The motion is estimated between the scans' reference instants: the stamps' interval, moved by how the
   // references lie within their sweeps (0 but for `field` times).
-  const double dt = started_ ? since_first - last_since_first_ + (times.reference - last_reference_) : 0.0;
+  const double stamp_interval = since_first - last_since_first_ + (times.reference - last_reference_);
+  const double dt = started_ ? motionInterval(stamp_interval, times.source, config_.sensor) : 0.0;
 
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
-  const Vector6d sweep_velocity = started_ ? motion_.velocity() : Vector6d::Zero();
-  const size_t occupied = backend_->projectScan(cloud, relative_stamp, {times.source, sweep_velocity, times.reference});
+  Vector6d sweep_velocity = started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero();
+  const size_t occupied = projectDeskewed(cloud, relative_stamp, times, sweep_velocity, result);
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
     FrameResult skipped = skip("too few valid points");
@@ -154,6 +249,7 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     skipped.gap_restart = result.gap_restart;
     skipped.time_warning = result.time_warning;
     skipped.sensor_warning = result.sensor_warning;
+    skipped.sensor_height_warning = result.sensor_height_warning;
     return skipped;
   }
 
@@ -169,22 +265,24 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   Eigen::Isometry3d stamp_in_reference = Eigen::Isometry3d::Identity();
   if (started_) {
     const Eigen::Isometry3d guess = initialGuess(dt, result);
-    const Vector6d deskewed_under = registerAndDeskew(guess, dt, sweep_velocity, times.farthest, result);
+    Vector6d deskewed_under =
+        registerAndDeskew(guess, motion_.informed(), dt, sweep_velocity, times.farthest, result);
+    result.refusal = guard_.refusal(result.registration, dt);
+    if (!result.refusal.empty() && !result.start_search.searched && config_.start_search.enabled) {
+      deskewed_under = searchAfterRefusal(dt, sweep_velocity, deskewed_under, times.farthest, result);
+    }
     result.times.registration += result.start_search.milliseconds;
-    reference_delta = result.registration.model_from_scan;
-    // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference`
-    // seconds before the reference instant) is exp(-reference * velocity) in the reference frame.
-    stamp_in_reference = expSE3(-times.reference * deskewed_under);
-    // The first scan of a start had no velocity to place its stamp in its sweep; registered against it
-    // as measured (bent alike), this scan measured the motion between like instants of the two sweeps.
-    if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
-    // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
-    result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
-    pose_ = pose_ * result.delta;
-    motion_.record(reference_delta, dt);
-    const Degeneracy& degeneracy = result.registration.degeneracy;
-    if (degeneracy.any()) ++degenerate_;
-    motion_.holdVelocityAlong(degeneracy.priorShare());
+    if (!result.refusal.empty()) {
+      const bool restarted = refuseRegistration(dt, result);
+      if (!restarted) {
+        ++processed_;
+        result.processed = true;
+        return result;
+      }
+    } else {
+      reference_delta = result.registration.model_from_scan;
+      stamp_in_reference = acceptRegistration(reference_delta, dt, deskewed_under, times, result);
+    }
   }
 
   stage_start = Clock::now();

@@ -35,12 +35,13 @@ std::vector<int> offsetsWithin(int n) {
   return offsets;
 }
 
-// Candidates along x every step within `reach` either way, the identity first.
-std::vector<Eigen::Isometry3d> motionsAlongX(double reach, const StartSearchConfig& config) {
+// Candidates along x every step within `reach` either way of `centre`, `centre` first.
+std::vector<Eigen::Isometry3d> motionsAlongX(const Eigen::Isometry3d& centre, double reach,
+                                             const StartSearchConfig& config) {
   std::vector<Eigen::Isometry3d> motions;
   for (int offset : offsetsWithin(stepsWithin(reach, config.step, kMaxStepsEachWay))) {
-    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-    motion.translation().x() = offset * config.step;
+    Eigen::Isometry3d motion = centre;
+    motion.translation().x() += offset * config.step;
     motions.push_back(motion);
   }
   return motions;
@@ -54,7 +55,7 @@ std::vector<Eigen::Isometry3d> yawsAround(const Eigen::Isometry3d& centre, doubl
   for (int offset : offsetsWithin(stepsWithin(yaw_reach, yaw_step, kMaxStepsEachWay))) {
     if (offset == 0) continue;
     Eigen::Isometry3d motion = centre;
-    motion.linear() = Eigen::AngleAxisd(offset * yaw_step, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    motion.linear() = Eigen::AngleAxisd(offset * yaw_step, Eigen::Vector3d::UnitZ()) * centre.linear();
     motions.push_back(motion);
   }
   return motions;
@@ -82,7 +83,8 @@ double fitScore(const NormalEquations& sums, const RegistrationConfig& config) {
   return term.JtJ.topLeftCorner<3, 3>().trace() / term.candidates;
 }
 
-StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config) {
+StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
+                                    const Eigen::Isometry3d& centre) {
   const auto start = Clock::now();
   const StartSearchConfig& search = config.start_search;
   const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * dt;
@@ -90,7 +92,7 @@ StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& c
   // reach hardly moves where the scan fits along x, so the two are searched one after the other rather
   // than on a grid of both, at a third of its cost.
   std::vector<Candidate> scored;
-  const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(search.max_speed * dt, search);
+  const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(centre, config.motion.max_speed * dt, search);
   for (const Eigen::Isometry3d& motion : along_x) {
     scored.push_back(registerCandidate(backend, motion, config.registration));
   }

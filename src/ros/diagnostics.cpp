@@ -26,6 +26,7 @@ std::string PipelineStatistics::Window::problems() const {
   add(time_warnings, "scans with unusable per-point times");
   add(sensor_misfits, "scans not fitting the sensor model");
   add(ambiguous_starts, "ambiguous starts (the motion at a start not told apart)");
+  add(refused, "registrations refused (beyond the motion bounds or collapsed)");
   return text.str();
 }
 
@@ -85,6 +86,17 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
     ++window_.sensor_misfits;
     last_sensor_warning_ = result.sensor_warning;
   }
+  if (!result.refusal.empty()) {
+    ++refusals_[result.refusal];
+    ++window_.refused;
+  }
+  lost_ = !result.refusal.empty();
+  if (result.recovered) ++recoveries_;
+  if (result.tracking_restart) {
+    ++tracking_restarts_;
+    ++window_.tracking_restarts;
+  }
+  if (!result.sensor_height_warning.empty()) last_sensor_height_warning_ = result.sensor_height_warning;
   if (result.start_search.searched) ++start_searches_;
   if (result.start_search.ambiguous) {
     ++ambiguous_starts_;
@@ -106,7 +118,13 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   if (degeneracy.any()) {
     problems += (problems.empty() ? "" : ", ") + std::string("latest scan degenerate along ") + degeneracy.describe();
   }
-  if (problems.empty()) {
+  if (lost_ || w.tracking_restarts > 0) {
+    // Lost: the latest scans' registrations were refused; their poses are the motion prior's.
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                   std::string(lost_ ? "lost: the latest registration was refused" : "tracking again") +
+                       (w.tracking_restarts > 0 ? ", model restarted after refusals in a row" : "") +
+                       (problems.empty() ? "" : ", " + problems));
+  } else if (problems.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, problems);
@@ -132,6 +150,10 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("scans degenerate", degenerate_scans_);
   status.add("start searches", start_searches_);
   status.add("ambiguous starts", ambiguous_starts_);
+  for (const auto& [reason, count] : refusals_) status.add("registrations refused: " + reason, count);
+  status.add("recoveries", recoveries_);
+  status.add("model restarts after refusals", tracking_restarts_);
+  if (!last_sensor_height_warning_.empty()) status.add("sensor height", last_sensor_height_warning_);
   for (const auto& [reason, count] : rejected_) status.add("clouds rejected: " + reason, count);
   for (const auto& [reason, count] : skipped_) status.add("scans skipped: " + reason, count);
   for (const auto& [reason, count] : restarts_) status.add("odometry restarts: " + reason, count);

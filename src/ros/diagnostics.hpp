@@ -49,6 +49,8 @@ class PipelineStatistics {
     size_t time_warnings = 0;
     size_t sensor_misfits = 0;
     size_t ambiguous_starts = 0;
+    size_t refused = 0;            // registrations refused (elo::FrameResult::refusal)
+    size_t tracking_restarts = 0;  // model restarts after refusals in a row
     double processing_ms_sum = 0.0;
     double processing_ms_max = 0.0;
     double latency_ms_sum = 0.0;
@@ -68,6 +70,11 @@ class PipelineStatistics {
   size_t degenerate_scans_ = 0;
   size_t start_searches_ = 0;    // elo::FrameResult::start_search
   size_t ambiguous_starts_ = 0;  // ... whose winner did not stand out
+  std::map<std::string, size_t> refusals_;  // refused registrations by reason
+  size_t recoveries_ = 0;
+  size_t tracking_restarts_ = 0;
+  bool lost_ = false;  // the latest registration was refused
+  std::string last_sensor_height_warning_;
   std::map<std::string, size_t> rejected_;
   std::map<std::string, size_t> skipped_;
   std::map<std::string, size_t> restarts_;

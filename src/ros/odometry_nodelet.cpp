@@ -205,6 +205,7 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   }
   if (!result.sensor_warning.empty()) NODELET_WARN_THROTTLE(kWarningPeriod, "%s", result.sensor_warning.c_str());
   logStartSearch(result.start_search);
+  logTrackingHealth(result);
   if (!result.processed) {
     lock.unlock();
     statistics_.scanSkipped(result.skip_reason);
@@ -228,6 +229,18 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   feedMap(result, converted.cloud, map_pose, map_generation);
 }
 
+void OdometryNodelet::logTrackingHealth(const elo::FrameResult& result) {
+  if (!result.sensor_height_warning.empty()) NODELET_WARN("%s", result.sensor_height_warning.c_str());
+  if (result.tracking_restart) {
+    NODELET_ERROR("lost: registrations refused %d times in a row (%s); the model restarts from this scan",
+                  odometry_->config().motion.restart_after, result.refusal.c_str());
+  } else if (!result.refusal.empty()) {
+    NODELET_WARN_THROTTLE(kWarningPeriod, "registration refused (%s): the pose is the motion prior's",
+                          result.refusal.c_str());
+  }
+  if (result.recovered) NODELET_INFO("tracking recovered after refused registrations");
+}
+
 void OdometryNodelet::logStartSearch(const elo::StartSearchResult& search) {
   if (!search.searched) return;
   const Eigen::Vector3d moved = search.motion.translation();
@@ -243,8 +256,9 @@ void OdometryNodelet::logStartSearch(const elo::StartSearchResult& search) {
 
 void OdometryNodelet::feedMap(const elo::FrameResult& result, const elo::PointCloud& cloud,
                               const Eigen::Isometry3d& sensor_pose, size_t generation) {
-  // Registered with a degenerate direction, the scan's pose along it is the motion prior's: left out.
-  if (!map_ || result.registration.degeneracy.any()) return;
+  // Registered with a degenerate direction, the scan's pose along it is the motion prior's, and a refused
+  // scan's pose is the prior's altogether: left out.
+  if (!map_ || result.registration.degeneracy.any() || !result.refusal.empty()) return;
   std::unique_lock<std::mutex> lock(odometry_mutex_);
   if (generation != map_generation_) return;  // ~reset since: the pose lies in the old odom frame
   if (!map_->takesNextScan()) return;

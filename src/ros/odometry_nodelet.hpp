@@ -68,6 +68,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   // Copies the processed scan's points for the drive's map, placed by `sensor_pose` (the odom frame);
   // after the scan's messages are out, so that the map never delays a pose.
   // `generation`: map_generation_ when the scan was processed; a scan from before a reset is left out.
+  // Says when a registration was refused, the track recovered or the sensor height does not fit.
+  void logTrackingHealth(const elo::FrameResult& result);
   // Says where the start search put a start in motion: a warning when the scans could not tell.
   void logStartSearch(const elo::StartSearchResult& search);
   void feedMap(const elo::FrameResult& result, const elo::PointCloud& cloud, const Eigen::Isometry3d& sensor_pose,

@@ -49,7 +49,8 @@ Simulation::Simulation(const SimulationSpec& spec)
   const Route route = routeFor(spec);
   world_ = std::make_unique<World>(spec.world, route,
                                    WorldOptions{spec.seed, spec.config.sensor.max_range + kReachMargin, spec.moving_cars});
-  trajectory_ = std::make_unique<SensorTrajectory>(route, world_->ground(), spec.config.ground.sensor_height);
+  trajectory_ = std::make_unique<SensorTrajectory>(route, world_->ground(), spec.config.ground.sensor_height,
+                                                   VehicleGeometry{}, spec.gait);
 }
 
 double Simulation::sweepStart(int frame) const { return frame / spec_.config.sensor.rotation_rate_hz; }

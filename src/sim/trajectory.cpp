@@ -301,8 +301,8 @@ Eigen::Isometry3d kittiVeloToCam00() {
 }
 
 SensorTrajectory::SensorTrajectory(const Route& route, const GroundSurface& ground, double sensor_height,
-                                   VehicleGeometry vehicle)
-    : route_(route), ground_(ground), sensor_height_(sensor_height), vehicle_(vehicle) {}
+                                   VehicleGeometry vehicle, Gait gait)
+    : route_(route), ground_(ground), sensor_height_(sensor_height), vehicle_(vehicle), gait_(gait) {}
 
 Eigen::Isometry3d SensorTrajectory::poseAt(double time) const {
   const Pose2 pose = route_.at(time);
@@ -325,7 +325,7 @@ Eigen::Isometry3d SensorTrajectory::poseAt(double time) const {
   Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
   sensor.linear() = rotation;
   sensor.translation() = onGround(position) + Eigen::Vector3d(0.0, 0.0, sensor_height_);
-  return sensor;
+  return sensor * gait_.offsetAt(time);
 }
 
 }  // namespace elo::sim

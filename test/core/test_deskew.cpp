@@ -106,6 +106,20 @@ TEST(Deskew, AzimuthTimesFollowKittisConvention) {
 // kernel runs per pixel: on a scan turning little, one turning fast, and one whose third block holds
 // points far enough from the reference to need the exact coefficients. Empty pixels, with a past scan's
 // point and time left in them, stay empty, as does a block without points (the fourth).
+// With times from the azimuth, the motion between two scans is measured over whole sweep periods: KITTI-raw
+// stamps rounded to 10 ms (0.10 and 0.11 s apart) give the same interval, a dropped scan two periods.
+TEST(Deskew, AzimuthMotionIntervalsAreWholeSweepPeriods) {
+  SensorConfig sensor;  // 10 Hz
+  EXPECT_DOUBLE_EQ(motionInterval(0.11, TimeSource::azimuth, sensor), 0.1);
+  EXPECT_DOUBLE_EQ(motionInterval(0.09, TimeSource::azimuth, sensor), 0.1);
+  EXPECT_DOUBLE_EQ(motionInterval(0.21, TimeSource::azimuth, sensor), 0.2);
+  EXPECT_DOUBLE_EQ(motionInterval(0.01, TimeSource::azimuth, sensor), 0.1) << "at least one period";
+  sensor.rotation_rate_hz = 20.0;
+  EXPECT_DOUBLE_EQ(motionInterval(0.11, TimeSource::azimuth, sensor), 0.1);
+  EXPECT_DOUBLE_EQ(motionInterval(0.11, TimeSource::field, sensor), 0.11) << "the driver's stamps are the sweeps'";
+  EXPECT_DOUBLE_EQ(motionInterval(0.11, TimeSource::none, sensor), 0.11);
+}
+
 TEST(Deskew, TheCpuPassOverPixelsGivesEachPixelThePerPixelMath) {
   ScanImage before;
   before.resize(4, 1024);  // a block of the pass per row

@@ -58,6 +58,29 @@ TEST(RosDiagnostics, StartSearchesAreCountedAndAnAmbiguousOneWarns) {
   EXPECT_EQ(valueOf(ambiguous, "ambiguous starts"), "1");
 }
 
+// A refused registration is lost: ERROR while it lasts, counted by reason; a recovery goes back to OK.
+TEST(RosDiagnostics, ARefusedRegistrationIsAnErrorUntilTheTrackRecovers) {
+  elo_ros::PipelineStatistics statistics;
+  elo::FrameResult refused = processedScan(60.0);
+  refused.refusal = elo::refusal::kAccelerates;
+  statistics.cloudReceived();
+  statistics.scanProcessed(refused, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper lost;
+  statistics.report(lost);
+  EXPECT_EQ(lost.level, diagnostic_msgs::DiagnosticStatus::ERROR) << lost.message;
+  EXPECT_NE(lost.message.find("lost"), std::string::npos) << lost.message;
+  EXPECT_EQ(valueOf(lost, std::string("registrations refused: ") + elo::refusal::kAccelerates), "1");
+
+  elo::FrameResult recovered = processedScan(60.0);
+  recovered.recovered = true;
+  statistics.cloudReceived();
+  statistics.scanProcessed(recovered, 65.0);
+  diagnostic_updater::DiagnosticStatusWrapper again;
+  statistics.report(again);
+  EXPECT_EQ(again.level, diagnostic_msgs::DiagnosticStatus::OK) << again.message;
+  EXPECT_EQ(valueOf(again, "recoveries"), "1");
+}
+
 TEST(RosDiagnostics, DropsRejectionsAndSkipsWarnAndAreCounted) {
   elo_ros::PipelineStatistics statistics;
   statistics.cloudReceived();

@@ -44,6 +44,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-range-bias -0.01" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-elevation-error -1" + out), 2);
   EXPECT_EQ(runTool("--world urban --poses /nonexistent/poses.txt" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --gait hop" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --bag" + out), 2);  // --bag without a file
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2"), 2);               // no output
   EXPECT_FALSE(std::filesystem::exists(directory.file("seq")));
@@ -52,7 +53,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
 TEST(EloSimCli, WritesASequence) {
   const elo::test::TempDirectory directory;
   EXPECT_EQ(runTool("--world parking --trajectory uturn --frames 3 --sensor vlp16 --seed 9 --noise 0.01 "
-                    "--dropout 0.05 --deskewed 0 --moving-cars 2 --beam-range-bias 0.01 --beam-elevation-error 0.05 "
+                    "--dropout 0.05 --deskewed 0 --moving-cars 2 --beam-range-bias 0.01 --beam-elevation-error 0.05 --gait walk "
                     "--threads 2 --output " + directory.file("seq")),
             0);
   for (const std::string file : {"velodyne/000000.bin", "velodyne/000002.bin", "poses.txt", "times.txt", "calib.txt"}) {

@@ -123,6 +123,30 @@ std::vector<Eigen::Isometry3d> curvyLidarPoses(int count) {
   return poses;
 }
 
+// The hand-held walk's gait: the yaw swing peaks at 2 pi f A = 188 deg/s, the rocking and the bob stay
+// within their amplitudes, and the offset is the identity at time 0; a trot's jolts lower the sensor at
+// each footfall.
+TEST(Gait, WalkAndTrotMoveTheSensorAsDescribed) {
+  const Gait walk = handheldWalk();
+  EXPECT_TRUE(walk.offsetAt(0.0).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  double fastest_yaw_rate = 0.0;
+  for (double t = 0.0; t < 2.0; t += 0.001) {
+    const Eigen::Isometry3d a = walk.offsetAt(t);
+    const Eigen::Isometry3d b = walk.offsetAt(t + 0.001);
+    const auto yaw = [](const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); };
+    fastest_yaw_rate = std::max(fastest_yaw_rate, std::abs(yaw(b) - yaw(a)) / 0.001);
+    EXPECT_LE(std::abs(a.translation().z()), walk.bob_m + 1e-12);
+    const Eigen::Vector3d up = a.rotation() * Eigen::Vector3d::UnitZ();
+    EXPECT_LE(std::acos(up.z()) * 180.0 / M_PI, walk.sway_deg * 1.2);
+  }
+  EXPECT_NEAR(fastest_yaw_rate * 180.0 / M_PI, 188.5, 5.0);
+  const Gait robot = trot();
+  EXPECT_NEAR(robot.offsetAt(0.0).translation().z(), -robot.bob_m, 1e-12) << "a footfall at time 0";
+  EXPECT_NEAR(robot.offsetAt(0.5 / robot.step_hz).translation().z(), 0.0, 1e-3) << "between footfalls";
+  EXPECT_FALSE(gaitFromName("hop"));
+  EXPECT_TRUE(gaitFromName("walk"));
+}
+
 TEST(SensorTrajectory, DrivenPosesAreFollowedInXY) {
   // Through a camera-frame KITTI file, as --poses reads one.
   const elo::test::TempDirectory directory;

@@ -30,6 +30,9 @@ struct SimulationSpec {
   // same drift with the opposite heading error (SparseSensors.*). Not with the azimuth time convention,
   // whose times are read from the turning direction.
   bool mirrored = false;
+  // How the sensor moves about the route's pose: carried by hand, on a legged robot (gait.hpp); none for
+  // a vehicle.
+  Gait gait;
 };
 
 class Simulation {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "elo/sim/gait.hpp"
 #include "elo/sim/ground.hpp"
 
 namespace elo::sim {
@@ -78,8 +79,9 @@ struct VehicleGeometry {
 // `sensor_height` straight above the ground under it, tilted with the plane through the wheels.
 class SensorTrajectory {
  public:
+  // `gait`: how the sensor moves about the route's pose (gait.hpp); none for a vehicle.
   SensorTrajectory(const Route& route, const GroundSurface& ground, double sensor_height,
-                   VehicleGeometry vehicle = {});
+                   VehicleGeometry vehicle = {}, Gait gait = {});
 
   Eigen::Isometry3d poseAt(double time) const;  // sensor in the world frame
   const Route& route() const { return route_; }
@@ -89,6 +91,7 @@ class SensorTrajectory {
   const GroundSurface& ground_;
   double sensor_height_;
   VehicleGeometry vehicle_;
+  Gait gait_;
 };
 
 }  // namespace elo::sim

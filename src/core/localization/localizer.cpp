@@ -305,7 +305,8 @@ LocalizationResult Localizer::update(const FrameResult& frame) {
   LocalizationResult result;
   // A restart is told on the scan that found time going backwards, processed or skipped.
   if (frame.reset) odometryRestarted();
-  if (frame.processed) {
+  // A refused registration left the odometry's model and pose where they were: nothing to match.
+  if (frame.processed && frame.refusal.empty()) {
     if (pending_hint_) {
       const PoseHint hint = *pending_hint_;
       pending_hint_.reset();
