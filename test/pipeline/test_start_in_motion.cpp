@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "elo/eval/evaluation.hpp"
+#include "elo/eval/kitti_metric.hpp"
 #include "elo/odometry.hpp"
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/simulation.hpp"
@@ -109,6 +110,35 @@ INSTANTIATE_TEST_SUITE_P(
         StartCase{"country_curves_os1_64_sweeps", sim::WorldFamily::country, sim::TrajectoryKind::curves, "os1-64",
                   true, RegistrationMode::frame_to_model, 150}),
     [](const ::testing::TestParamInfo<StartCase>& info) { return info.param.name; });
+
+#ifdef ELO_START_IN_MOTION_LONG
+// The highway drive started at speed tracks as the same drive started at rest does over the same scans:
+// t_rel over 50-100 m segments of scans 200-300 (250 m at 25 m/s) within twice that of the run from rest.
+TEST(StartInMotionLong, TheHighwayStartedAtSpeedTracksAsTheDriveFromRest) {
+  const StartCase start{"highway", sim::WorldFamily::highway, sim::TrajectoryKind::straight, "hdl64", true,
+                        RegistrationMode::frame_to_model, 200};
+  constexpr int kScans = 100;
+  const sim::Simulation simulation(specOf(start, start.first_frame + kScans));
+  const StartedRun at_speed = runFrom(simulation, start, kScans);
+  StartCase from_rest = start;
+  from_rest.first_frame = 0;
+  const StartedRun at_rest = runFrom(simulation, from_rest, start.first_frame + kScans);
+  const auto drift = [](const std::vector<FrameResult>& results, const std::vector<Eigen::Isometry3d>& truth,
+                        size_t first) {
+    std::vector<Eigen::Isometry3d> estimate, expected;
+    for (size_t i = first; i < results.size(); ++i) {
+      estimate.push_back(results[i].pose);
+      expected.push_back(truth[i]);
+    }
+    return averageDrift(kittiSegmentErrors(expected, estimate, {50.0, 100.0}, 1));
+  };
+  const DriftError started = drift(at_speed.results, at_speed.truth, 0);
+  const DriftError rested = drift(at_rest.results, at_rest.truth, start.first_frame);
+  std::printf("[ start    ] highway scans 200-300: t_rel %.4f %% started at 25 m/s, %.4f %% from rest\n",
+              started.t_rel_percent, rested.t_rel_percent);
+  EXPECT_LT(started.t_rel_percent, 2.0 * rested.t_rel_percent);
+}
+#endif
 
 // Deep in a tunnel nothing tells how far the vehicle went between two scans: every candidate along the
 // axis fits alike. The start is taken (the pose must go on) but told as ambiguous and counted.
