@@ -203,7 +203,9 @@ nav_msgs::Odometry odometryMessage(const elo::FrameResult& result, double dt, co
   // The registration's covariance is about this scan's motion, in the sensor frame; the adjoint of the
   // extrinsic moves it to the child frame. It is the uncertainty this scan adds to the pose: odometry
   // has no absolute reference, so the pose covariance is the per-scan (differential) one.
-  std::optional<elo::Matrix6d> motion_covariance = registrationCovariance(result.registration);
+  // A refused registration (docs/robustness.md#a-lost-track) left the motion to the prior: unknown (-1).
+  std::optional<elo::Matrix6d> motion_covariance =
+      result.refusal.empty() ? registrationCovariance(result.registration) : std::nullopt;
   if (motion_covariance) {
     const elo::Matrix6d ad = adjoint(frames.base_from_sensor);
     motion_covariance = ad * *motion_covariance * ad.transpose();

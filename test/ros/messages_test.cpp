@@ -185,6 +185,12 @@ TEST(RosMessages, OdometryTwistAndCovarianceAreInTheChildFrame) {
   EXPECT_LT(largestDifference(pose_covariance, pose_covariance.transpose()), 1e-18);
   EXPECT_LT(largestDifference(twist_covariance, pose_covariance / (dt * dt)), 1e-15);
 
+  elo::FrameResult refused = result;
+  refused.refusal = elo::refusal::kAccelerates;  // its pose is the motion prior's
+  const nav_msgs::Odometry prior = elo_ros::odometryMessage(refused, dt, binding, ros::Time(3, 0));
+  EXPECT_EQ(prior.pose.covariance[0], -1.0);
+  EXPECT_EQ(prior.twist.covariance[0], -1.0);
+
   result.registration.failed = true;
   const nav_msgs::Odometry unknown = elo_ros::odometryMessage(result, dt, binding, ros::Time(3, 0));
   EXPECT_EQ(unknown.pose.covariance[0], -1.0);
