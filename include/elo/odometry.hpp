@@ -77,8 +77,10 @@ class Odometry {
   // Processes one sweep. A scan that cannot be used (empty, too few valid points, a stamp that is not
   // finite or repeats the last one to the nanosecond) is skipped, counted under its reason and leaves the state as it was.
   // A stamp before the last one resets (see reset()); one more than model.time_window after it restarts
-  // the model at the current pose (FrameResult::gap_restart). It returns, normally or by an exception,
-  // only once the backend no longer reads a cloud handed to prefetch().
+  // the model at the current pose (FrameResult::gap_restart). A scan whose motion is unknown has it
+  // searched (FrameResult::start_search); a registration beyond what the platform can do is refused
+  // (FrameResult::refusal: the scan is processed, its pose the motion prior's). It returns, normally or
+  // by an exception, only once the backend no longer reads a cloud handed to prefetch().
   FrameResult process(const PointCloud& cloud);
 
   // Hands over the scan a later process() call will be given, normally the call after the next one, so
