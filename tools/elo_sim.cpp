@@ -88,6 +88,9 @@ std::string usage() {
          "                       hand (swung +-30 deg at 1 Hz, rocked +-10 deg, bobbing 4 cm at 1.8 steps\n"
          "                       a second); trot, on a legged robot (jolts of 3 cm and 4 deg at 3 footfalls\n"
          "                       a second); default none (a vehicle)\n"
+         "  --stamp-rounding S   record the stamps rounded to S seconds (times.txt, the scans, the bag), as\n"
+         "                       KITTI-raw's are to 0.01; the ground truth stays at the true instants\n"
+         "                       (default 0: exact)\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -113,7 +116,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
       "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
-      "--mirror", "--gait"};
+      "--mirror", "--gait", "--stamp-rounding"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -229,6 +232,10 @@ Options parseOptions(int argc, char** argv) {
     const std::optional<elo::sim::Gait> named = elo::sim::gaitFromName(*gait);
     if (!named) throw UsageError("--gait expects " + joined(elo::sim::gaitNames()) + ", got '" + *gait + "'");
     spec.gait = *named;
+  }
+  if (const auto rounding = take("--stamp-rounding")) {
+    spec.stamp_rounding = elo::tools::parseNumber<double>("--stamp-rounding", *rounding);
+    if (!(spec.stamp_rounding >= 0.0)) throw UsageError("--stamp-rounding must not be negative");
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;

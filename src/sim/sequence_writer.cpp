@@ -87,7 +87,7 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
           tbb::make_filter<Frame, void>(FilterMode::serial_in_order, [&](const Frame& frame) {
             poses[frame.index] = frame.index == 0 ? Eigen::Isometry3d::Identity()  // exactly, not up to rounding
                                                   : first_inverse * simulation.sensorPose(frame.index);
-            stamps[frame.index] = simulation.stamp(frame.index);
+            stamps[frame.index] = simulation.recordedStamp(frame.index);
             points += frame.scan->cloud.size();
             if (sink) sink(*frame.scan, poses[frame.index]);
           }));

@@ -1,6 +1,7 @@
 #include "elo/sim/simulation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +58,11 @@ double Simulation::sweepStart(int frame) const { return frame / spec_.config.sen
 
 double Simulation::stamp(int frame) const { return sweepStart(frame) + lidar_.referenceOffset(); }
 
+double Simulation::recordedStamp(int frame) const {
+  const double rounding = spec_.stamp_rounding;
+  return rounding > 0.0 ? std::round(stamp(frame) / rounding) * rounding : stamp(frame);
+}
+
 Eigen::Isometry3d Simulation::sensorPose(int frame) const {
   const Eigen::Isometry3d pose = trajectory_->poseAt(stamp(frame));
   return spec_.mirrored ? mirrorOf(pose) : pose;
@@ -74,6 +80,7 @@ SimulatedScan Simulation::scan(int frame) const {
   if (spec_.mirrored) {
     for (Vec3f& point : scan.cloud.points) point.y() = -point.y();
   }
+  scan.cloud.stamp = recordedStamp(frame);
   return scan;
 }
 

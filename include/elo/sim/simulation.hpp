@@ -33,6 +33,9 @@ struct SimulationSpec {
   // How the sensor moves about the route's pose: carried by hand, on a legged robot (gait.hpp); none for
   // a vehicle.
   Gait gait;
+  // Seconds the scans' recorded stamps are rounded to (0: exact), as KITTI-raw's times.txt rounds them to
+  // 10 ms: the scans are still taken a sweep apart, and the ground truth is at the true instants.
+  double stamp_rounding = 0.0;
 };
 
 class Simulation {
@@ -46,6 +49,8 @@ class Simulation {
   // The frame's reference instant (s): its scan's stamp, the sweep's start but for a sweep with motion
   // in the azimuth convention, whose reference is mid-sweep (Lidar::referenceOffset).
   double stamp(int frame) const;
+  // The stamp the frame's scan is recorded with: stamp(), rounded to SimulationSpec::stamp_rounding.
+  double recordedStamp(int frame) const;
   Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the frame's reference instant
   SimulatedScan scan(int frame) const;
 
