@@ -226,8 +226,8 @@ struct MotionConfig {
   double max_speed = 40.0;           // m/s; also the start search's reach along x
   double max_turn_rate_deg = 360.0;  // deg/s
   // m/s^2: the change of velocity from one registration to the next over their interval. 2 g: a car
-  // brakes at 0.8 g, a walker's step and a trot's shocks stay under 1.5 g; a wrong registration on a
-  // hand-held walk jumps by metres a scan (tens of g).
+  // brakes at 0.8 g, and a walker's steps and a trot's jolts, as scans 0.1 s apart see them, stay under
+  // it; a wrong registration on a hand-held walk jumps by metres a scan (tens of g).
   double max_acceleration = 20.0;
   // s: how far a scan's stamp may lie from when it was taken. A velocity is a registered motion over
   // the stamps' interval, so a stamp error of e makes two consecutive velocities differ by up to
