@@ -25,7 +25,8 @@ struct Candidate {
 
 // Steps of `step` within `reach` either side of zero, at most `limit` each way: -n..n.
 int stepsWithin(double reach, double step, int limit) {
-  return std::min(limit, static_cast<int>(std::floor(reach / step + 1e-9)));
+  // Compared as doubles: a reach of many steps (a bound set very high) must not overflow the int.
+  return static_cast<int>(std::min<double>(limit, std::floor(reach / step + 1e-9)));
 }
 
 // 0, -1, 1, -2, 2, ... -n, n: the offsets of a line of candidates, nearest the centre first.
