@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/common/eigen_interop.hpp"
+#include "core/median.hpp"
 #include "elo/sensor_model.hpp"
 
 namespace elo {
@@ -25,8 +27,7 @@ double medianBeamGap(const SensorConfig& sensor) {
     if (gap > 0.0) gaps.push_back(gap);  // two lasers at one elevation are one row
   }
   if (gaps.empty()) return 0.0;
-  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-  return gaps[gaps.size() / 2];
+  return upperMedian(std::move(gaps));
 }
 
 }  // namespace

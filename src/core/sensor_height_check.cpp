@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 
+#include "core/median.hpp"
+
 namespace elo {
 namespace {
 
@@ -94,9 +96,7 @@ std::optional<double> groundHeightBelow(const PointCloud& cloud, size_t stride) 
 
 std::optional<double> SensorHeightCheck::measured() const {
   if (recent_.empty()) return std::nullopt;
-  std::vector<double> sorted(recent_.begin(), recent_.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  return sorted[sorted.size() / 2];
+  return upperMedian(std::vector<double>(recent_.begin(), recent_.end()));
 }
 
 std::string SensorHeightCheck::add(const PointCloud& cloud) {

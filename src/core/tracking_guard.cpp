@@ -1,8 +1,9 @@
 #include "elo/tracking_guard.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <vector>
+
+#include "core/median.hpp"
 
 namespace elo {
 namespace {
@@ -35,9 +36,8 @@ std::string TrackingGuard::refusal(const RegistrationResult& registration, doubl
     }
   }
   if (recent_inliers_.size() >= kFewestRecentForCollapse) {
-    std::vector<int> sorted(recent_inliers_.begin(), recent_inliers_.end());
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    if (sceneInliers(registration) < config_.min_inlier_share_of_recent * sorted[sorted.size() / 2]) {
+    const int median = upperMedian(std::vector<int>(recent_inliers_.begin(), recent_inliers_.end()));
+    if (sceneInliers(registration) < config_.min_inlier_share_of_recent * median) {
       return refusal::kInliersCollapsed;
     }
   }
