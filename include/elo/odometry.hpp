@@ -43,13 +43,11 @@ struct FrameResult {
   // first registration after a start, a reset or a restart, with start_search.enabled).
   StartSearchResult start_search;
   // Tracking health (docs/robustness.md#a-lost-track). Why the registration was refused (a
-  // refusal:: reason of tracking_guard.hpp), empty when it was accepted. A refused scan is processed, but
+  // refusal:: reason of tracking_guard.hpp), empty when it was accepted; a registration from the prior
+  // that is refused is searched and registered again first, and this is that second one's reason. A refused scan is processed, but
   // its pose is the motion prior's and it changed neither the model nor the velocity.
   std::string refusal;
   bool recovered = false;         // accepted after refused ones
-  // Its registration from the motion prior was refused, and the scan searched and registered again
-  // (start_search); `refusal` is then that of the second registration.
-  bool searched_after_refusal = false;
   // motion.restart_after refusals in a row: the model restarted from this scan, at the refused pose.
   bool tracking_restart = false;
   // Deskewed under the last velocity the scan filled too few pixels; projected again without deskew.
@@ -172,7 +170,8 @@ class Odometry {
   // The start search (start_search.hpp) for a scan whose motion is unknown: around the motion accepted
   // last carried over `dt` when a refusal made the motion unknown (its reach along x spans a vehicle that
   // stopped as well as one that drove on); around the identity at a start, when none was accepted.
-  StartSearchResult searchMotion(double dt);
+  // Recorded in `result.start_search` and counted.
+  void searchMotion(double dt, FrameResult& result);
   // The velocity a scan is deskewed under before it is registered: the last registered (the motion
   // prior's), or after a refusal the one accepted last; zero at a start and without a motion prior.
   Vector6d sweepVelocityBeforeRegistration() const;

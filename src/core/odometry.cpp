@@ -114,9 +114,7 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool inform
 
 Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
   if (motion_.known() || !config_.start_search.enabled) return motion_.predict(dt);
-  result.start_search = searchMotion(dt);
-  ++start_searches_;
-  if (result.start_search.ambiguous) ++ambiguous_starts_;
+  searchMotion(dt, result);
   return result.start_search.motion;
 }
 
@@ -160,10 +158,7 @@ Vector6d Odometry::searchAfterRefusal(double dt, const Vector6d& projected_under
   // The refused registration's motion may have deskewed the scan: back to how it was projected.
   if (deskewed_under != projected_under) deskewScanAgain(projected_under, result);
   result.deskew_rounds = 0;
-  result.start_search = searchMotion(dt);
-  ++start_searches_;
-  if (result.start_search.ambiguous) ++ambiguous_starts_;
-  result.searched_after_refusal = true;
+  searchMotion(dt, result);
   const Vector6d searched_under =
       registerAndDeskew(result.start_search.motion, false, dt, projected_under, farthest, result);
   result.refusal = guard_.refusal(result.registration, dt);
@@ -188,8 +183,10 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
   return true;
 }
 
-StartSearchResult Odometry::searchMotion(double dt) {
-  return searchStartMotion(*backend_, dt, config_, expSE3(held_velocity_ * dt));
+void Odometry::searchMotion(double dt, FrameResult& result) {
+  result.start_search = searchStartMotion(*backend_, dt, config_, expSE3(held_velocity_ * dt));
+  ++start_searches_;
+  if (result.start_search.ambiguous) ++ambiguous_starts_;
 }
 
 Vector6d Odometry::sweepVelocityBeforeRegistration() const {
