@@ -320,21 +320,14 @@ class Report {
   std::map<std::string, size_t> unreadable_;
 };
 
-// The scans the run plays: playOrder's, or with --start every --stride-th scan from scan N, at its
-// recorded stamp (the odometry starts at the first scan it is given, whatever its stamp).
+// The scans the run plays (playOrder), each at its recorded stamp: the odometry starts at the first scan
+// it is given, whatever its stamp.
 std::vector<elo::PlayedScan> playedScans(const elo::ScanSource& source, const Options& options) {
-  if (options.start == 0) return elo::playOrder(source, options.stride, options.reverse, options.max_frames);
-  if (options.start >= source.size()) {
+  if (options.start > 0 && options.start >= source.size()) {
     throw UsageError("--start " + std::to_string(options.start) + ": the input has " + std::to_string(source.size()) +
                      " scans");
   }
-  const std::vector<elo::PlayedScan> every = elo::playOrder(source, 1, false);
-  std::vector<elo::PlayedScan> played;
-  for (size_t i = options.start; i < every.size(); i += options.stride) {
-    if (options.max_frames > 0 && played.size() == options.max_frames) break;
-    played.push_back(every[i]);
-  }
-  return played;
+  return elo::playOrder(source, options.stride, options.reverse, options.max_frames, options.start);
 }
 
 void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const elo::FrameResult& r) {

@@ -34,10 +34,11 @@ std::string chooseCloudTopic(const std::string& bag, const std::vector<BagTopic>
   return clouds.front().name;
 }
 
-std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames) {
+std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames,
+                                  size_t first) {
   if (stride == 0) throw std::invalid_argument("the stride between played scans must be at least 1");
   std::vector<PlayedScan> played;
-  for (size_t index = 0; index < source.size(); index += stride) played.push_back({index, source.stamp(index)});
+  for (size_t index = first; index < source.size(); index += stride) played.push_back({index, source.stamp(index)});
   if (reverse && !played.empty()) {
     const double mirror = played.front().stamp + played.back().stamp;
     std::reverse(played.begin(), played.end());

@@ -182,6 +182,8 @@ TEST(PlayOrder, AStrideTakesEveryKthScanAtItsRecordedTime) {
   expectPlayed(playOrder(sequence, 1, false), {0, 1, 2, 3, 4, 5, 6}, {0.0, 0.1, 0.21, 0.3, 0.42, 0.5, 0.61});
   expectPlayed(playOrder(sequence, 3, false), {0, 3, 6}, {0.0, 0.3, 0.61});
   expectPlayed(playOrder(sequence, 2, false, 2), {0, 2}, {0.0, 0.21});
+  expectPlayed(playOrder(sequence, 2, false, 0, 3), {3, 5}, {0.3, 0.5});  // from scan 3: elo_run --start
+  expectPlayed(playOrder(sequence, 1, false, 2, 4), {4, 5}, {0.42, 0.5});
   EXPECT_THROW(playOrder(sequence, 0, false), std::invalid_argument);
 }
 

@@ -72,11 +72,12 @@ struct PlayedScan {
   double stamp;
 };
 
-// The scans a run plays, in order: every `stride`-th scan from the first (a faster drive, or dropped
-// frames) and, with `reverse`, last to first; at most `max_frames` of them (0: all). A reverse run drives
-// the route backwards rather than back in time: its stamps are mirrored about the played span, so they
-// still advance by the recorded intervals. Per-point times within a scan are not mirrored. Throws
-// std::invalid_argument for a stride of 0.
-std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames = 0);
+// The scans a run plays, in order: every `stride`-th scan from scan `first` (a faster drive, or dropped
+// frames; a drive cut mid-way) and, with `reverse`, last to first; at most `max_frames` of them (0: all).
+// A reverse run drives the route backwards rather than back in time: its stamps are mirrored about the
+// played span, so they still advance by the recorded intervals. Per-point times within a scan are not
+// mirrored. Throws std::invalid_argument for a stride of 0.
+std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames = 0,
+                                  size_t first = 0);
 
 }  // namespace elo
