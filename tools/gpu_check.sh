@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The CUDA backend's check, in one table: the CPU/CUDA agreement tests, compute-sanitizer's memcheck and
-# racecheck over a few real scans (deskew on, so that every kernel runs) and over localization's map
-# rendering, elo_run's poses with and without the overlapped upload, localization on both backends, and
-# the CPU-against-GPU bench, frame-to-model, over simulated drives of three sensors and the real scans.
+# The CUDA backend's check, in one table: the CPU/CUDA agreement tests (every stage, whole drives, maps,
+# localization, a start in motion, refused registrations), compute-sanitizer's memcheck, racecheck,
+# initcheck and synccheck over a few real scans (deskew on, so that every kernel runs) and over
+# localization's map rendering, elo_run's poses with and without the overlapped upload, localization on
+# both backends, and the CPU-against-GPU bench, frame-to-model, over simulated drives of three sensors and
+# the real scans.
 #
 # On a GPU machine with a full build:   tools/gpu_check.sh build/devel/lib/elo_odometry [SCANS_DIR]
 # From a kit packed by gpu_kit.sh:      bash .gpukit/setup.sh && source .gpukit/env.sh && tools/gpu_check.sh
@@ -123,9 +125,11 @@ check_localization() {
   fi
   row "localization, $name" "CPU and CUDA poses within $difference m; FPS CPU $(fps_with_localization "$cpu"),\
  CUDA $(fps_with_localization "$cuda")"
-  check_sanitizer memcheck "ERROR SUMMARY" "5 scans localized" "$input" --localize "$map"
-  check_sanitizer racecheck "RACECHECK SUMMARY" "5 scans localized" "$input" --localize "$map"
+  for tool in memcheck racecheck initcheck synccheck; do
+    check_sanitizer $tool "$(sanitizer_summary $tool)" "5 scans localized" "$input" --localize "$map"
+  done
 }
+sanitizer_summary() { if [ "$1" = racecheck ]; then echo "RACECHECK SUMMARY"; else echo "ERROR SUMMARY"; fi; }
 fps_with_localization() { sed -n 's/^FPS with localization: \([0-9.]*\).*/\1/p' <<<"$1"; }
 
 simulate() {  # simulate SENSOR WORLD TRAJECTORY DIR [options]
@@ -142,10 +146,8 @@ check_agreement
 simulate hdl64 urban curves "$work/hdl64"
 check_localization "HDL-64E, urban, $frames scans" "$work/hdl64"
 # The real scans deskewed by azimuth, so that every kernel of the odometry runs.
-for tool in memcheck racecheck synccheck; do
-  summary="ERROR SUMMARY"
-  [ $tool = racecheck ] && summary="RACECHECK SUMMARY"
-  check_sanitizer $tool "$summary" "5 real scans" "$scans" --set deskew.time_source=azimuth
+for tool in memcheck racecheck initcheck synccheck; do
+  check_sanitizer $tool "$(sanitizer_summary $tool)" "5 real scans" "$scans" --set deskew.time_source=azimuth
 done
 
 bench=()

@@ -66,6 +66,11 @@ class DoubleBufferedUpload {
     return {free.buffers, false};
   }
 
+  // Runs `prepare` on both buffers (to size them); before the first prefetch, when the caller owns both.
+  void prepareBoth(const std::function<void(Buffers&)>& prepare) {
+    for (Slot& slot : slots_) prepare(slot.buffers);
+  }
+
   // Waits until the staging thread is done: it no longer reads the cloud last prefetched.
   void finish() noexcept { stager_.wait(); }
 

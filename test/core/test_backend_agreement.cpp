@@ -379,6 +379,58 @@ TEST(BackendAgreement, PosesAgreeOnADriveOfDeskewedSweeps) {
   }
 }
 
+// Started on a vehicle already driving 15 m/s (docs/start_in_motion.md): the start search runs on the
+// second scan, through each backend's linearisation, and must pick the same motion on both; with sweeps,
+// the first scan is then deskewed again and the model rebuilt from it, on both.
+TEST(BackendAgreement, PosesAgreeStartedInMotion) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  Vector6d velocity;
+  velocity << 15.0, 0.0, 0.0, 0.0, 0.0, 0.05;
+  for (const bool sweeps : {false, true}) {
+    for (const RegistrationMode mode : {RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame}) {
+      OdometryOnBothBackends odometry(mode);
+      for (int frame = 0; frame < 8; ++frame) {
+        const Eigen::Isometry3d truth = pose(-25, 0, 0, 0, 0, 0) * expSE3(0.1 * frame * velocity);
+        const PointCloud cloud =
+            sweeps ? test::sweepScene(test::streetScene(), config.sensor, truth, velocity, 0.1 * frame).cloud
+                   : streetScan(config, truth, 0.1 * frame, 0.02);
+        const FrameResult a = odometry.cpu.process(cloud);
+        const FrameResult b = odometry.cuda.process(cloud);
+        ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+        expectAgreeingPoses(a.pose, b.pose, frame);
+      }
+      EXPECT_EQ(odometry.cpu.startSearchCount(), 1u);
+      EXPECT_EQ(odometry.cuda.startSearchCount(), odometry.cpu.startSearchCount());
+      EXPECT_EQ(odometry.cuda.ambiguousStartCount(), odometry.cpu.ambiguousStartCount());
+    }
+  }
+}
+
+// The tracking guard (docs/robustness.md#a-lost-track) on both backends: a scan taken turned 60 deg from
+// where the car can be (a turn beyond motion.max_turn_rate_deg) is refused alike, its pose held from the
+// prior, and the next scans are searched and recovered alike.
+TEST(BackendAgreement, RefusalsAndRecoveriesAgree) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  OdometryOnBothBackends odometry(RegistrationMode::frame_to_model);
+  size_t refused = 0;
+  for (int frame = 0; frame < 10; ++frame) {
+    const double turned = frame == 5 ? 60.0 : 0.0;
+    const PointCloud cloud = streetScan(config, pose(-20 + 0.8 * frame, 0, 0, 0, 0, turned), 0.1 * frame, 0.02);
+    const FrameResult a = odometry.cpu.process(cloud);
+    const FrameResult b = odometry.cuda.process(cloud);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    EXPECT_EQ(a.refusal, b.refusal) << "frame " << frame;
+    EXPECT_EQ(a.recovered, b.recovered) << "frame " << frame;
+    refused += !a.refusal.empty();
+    expectAgreeingPoses(a.pose, b.pose, frame);
+  }
+  EXPECT_GE(refused, 1u);
+  EXPECT_EQ(odometry.cuda.refusalCounts(), odometry.cpu.refusalCounts());
+  EXPECT_EQ(odometry.cuda.recoveryCount(), odometry.cpu.recoveryCount());
+}
+
 TEST(BackendAgreement, RealScansAgreeStageByStageAndInPose) {
   ELO_REQUIRE_CUDA();
   if (!std::filesystem::is_directory(kRealScans)) {

@@ -90,7 +90,7 @@ void CudaBackend::FittedGroundNormals::startEpoch(size_t points, cudaStream_t st
 void CudaBackend::MapBuffers::reserveRender(size_t sources) {
   if (sources > indices.capacity()) {
     constexpr size_t kBytesPerSource = sizeof(int32_t) + 2 * sizeof(Float3) + 2 * sizeof(int);
-    requireDeviceMemory(sources * kBytesPerSource, indices.capacity() * kBytesPerSource,
+    requireDeviceMemory(grownCapacity(indices.capacity(), sources) * kBytesPerSource, indices.capacity() * kBytesPerSource,
                         "the " + std::to_string(sources) + " map points of one render");
   }
   staged_indices.reserve(sources);
@@ -163,6 +163,9 @@ void CudaBackend::allocate() {
   partial_sums_.reserve(kTerms * kPartialRows * kReductionBlocks);
   finished_blocks_.reserve(1);
   host_term_sums_.reserve(kTerms);
+  // Room for a scan of a point per pixel in both upload buffers, so that a drive's first scans do not
+  // allocate (grownCapacity()); a denser sensor's grows them a few times.
+  uploads_.prepareBoth([this](UploadBuffers& buffers) { buffers.reserve(pixels_); });
 }
 
 // Empty images and maps, and the compaction scratch at "none" (all bytes 0xff), as the kernels expect.
@@ -230,6 +233,15 @@ CellCompaction CudaBackend::compaction() const {
 CellCompaction CudaBackend::mapCompaction() const {
   return {cell_keys_.data(),          surface_keys_.data(),     first_sources_.data(),
           map_.source_cells.data(), map_.first_flags.data(), map_.tile_firsts.data()};
+}
+
+void CudaBackend::UploadBuffers::reserve(size_t points_wanted) {
+  staged_points.reserve(points_wanted);
+  points.reserve(points_wanted);
+  staged_rings.reserve(points_wanted);
+  rings.reserve(points_wanted);
+  staged_times.reserve(points_wanted);
+  times.reserve(points_wanted);
 }
 
 void CudaBackend::UploadBuffers::stage(const HostCloud& cloud) {
@@ -525,7 +537,7 @@ void CudaBackend::uploadHeldMap() {
   // The smaller of the two: an allocation that failed halfway leaves the normals shorter.
   const size_t capacity = std::min(map_.points.capacity(), map_.normals.capacity());
   if (count > capacity) {
-    requireDeviceMemory(count * 2 * sizeof(Float3), capacity * 2 * sizeof(Float3),
+    requireDeviceMemory(grownCapacity(capacity, count) * 2 * sizeof(Float3), capacity * 2 * sizeof(Float3),
                         "the " + std::to_string(count) + " map points near the vehicle");
     map_.points.reserve(count);
     map_.normals.reserve(count);

@@ -1,11 +1,11 @@
 // The CUDA implementation of the backend interface: the stages of src/core/cuda/*.cu, queued on one
 // stream over device buffers that mirror include/elo/types.hpp and are allocated once, in the
-// constructor (only the cloud upload grows, when a scan has more points than any before, and
-// localization's map and render buffers, with the largest part of the map held and the largest
-// render). The scan goes up through pinned memory, in one of two upload buffers: the next scan, when
-// prefetched, is staged into the other one on a thread of its own and copied on a stream of its own
-// while this one is processed. The host views are copied back when asked for, and only when the device
-// buffers changed since.
+// constructor, the upload's for a point per pixel. Only the upload grows, by half (grownCapacity()), when
+// a scan has more points than it holds, and so do localization's map and render buffers, with the
+// largest part of the map held and the largest render. The scan goes up through pinned memory, in one of
+// two upload buffers: the next scan, when prefetched, is staged into the other one on a thread of its own
+// and copied on a stream of its own while this one is processed. The host views are copied back when
+// asked for, and only when the device buffers changed since.
 #pragma once
 
 #include <memory>
@@ -135,6 +135,8 @@ class CudaBackend final : public Backend {
     bool has_rings = false;
     bool has_times = false;
 
+    // Room for a cloud of `points_wanted` points, with rings and times.
+    void reserve(size_t points_wanted);
     // Copies `cloud` into the pinned memory, growing the buffers as needed.
     void stage(const HostCloud& cloud);
     // Queues the copy of the staged cloud to the device on `stream`.

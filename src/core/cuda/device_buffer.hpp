@@ -4,6 +4,7 @@
 
 #include <cuda_runtime_api.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -17,6 +18,13 @@ inline void check(cudaError_t status, const char* what) {
   }
 }
 
+// What an array holding `capacity` elements and asked for `count` more than that grows to: by half at
+// least. Arrays sized per scan or per render (the upload, a map render's points) are asked for a little
+// more than ever before many times over a drive's first scans; each reallocation costs a free that waits
+// for the device and an allocation, together longer than a frame (pinned memory most), so they happen a
+// few times rather than at each new largest scan.
+inline size_t grownCapacity(size_t capacity, size_t count) { return std::max(count, capacity + capacity / 2); }
+
 // An array in device memory. It is allocated up front and grows only when asked for more than ever
 // before, so the frames themselves never allocate.
 template <typename T>
@@ -28,16 +36,17 @@ class DeviceArray {
   DeviceArray(const DeviceArray&) = delete;
   DeviceArray& operator=(const DeviceArray&) = delete;
 
-  // Makes room for `count` elements; the contents are lost when it has to reallocate.
+  // Makes room for `count` elements (grownCapacity()); the contents are lost when it has to reallocate.
   void reserve(size_t count) {
     if (count <= capacity_) return;
+    const size_t capacity = grownCapacity(capacity_, count);
     cudaFree(data_);
     data_ = nullptr;
     capacity_ = 0;
     void* memory = nullptr;
-    check(cudaMalloc(&memory, count * sizeof(T)), "cudaMalloc");
+    check(cudaMalloc(&memory, capacity * sizeof(T)), "cudaMalloc");
     data_ = static_cast<T*>(memory);
-    capacity_ = count;
+    capacity_ = capacity;
   }
 
   T* data() const { return data_; }
@@ -58,16 +67,17 @@ class PinnedArray {
   PinnedArray(const PinnedArray&) = delete;
   PinnedArray& operator=(const PinnedArray&) = delete;
 
-  // Makes room for `count` elements; the contents are lost when it has to reallocate.
+  // Makes room for `count` elements (grownCapacity()); the contents are lost when it has to reallocate.
   void reserve(size_t count) {
     if (count <= capacity_) return;
+    const size_t capacity = grownCapacity(capacity_, count);
     cudaFreeHost(data_);
     data_ = nullptr;
     capacity_ = 0;
     void* memory = nullptr;
-    check(cudaMallocHost(&memory, count * sizeof(T)), "cudaMallocHost");
+    check(cudaMallocHost(&memory, capacity * sizeof(T)), "cudaMallocHost");
     data_ = static_cast<T*>(memory);
-    capacity_ = count;
+    capacity_ = capacity;
   }
 
   T* data() const { return data_; }
