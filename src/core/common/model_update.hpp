@@ -76,4 +76,25 @@ ELO_HOST_DEVICE inline ClosestKey oldestWinsKey(float stamp, uint32_t source) {
 // The source of a second-round key.
 ELO_HOST_DEVICE inline uint32_t oldestWinsSource(ClosestKey key) { return unscrambledSource(closestWinsSource(key)); }
 
+// A pixel of a spherical image: its point, normal, range and observation time.
+struct ImagePixel {
+  Float3 vertex;
+  Float3 normal;
+  float range;
+  float stamp;
+};
+
+// What the winning `source` of a fused pixel leaves there: the scan's pixel as observed, or the model's
+// point and normal moved into the scan's frame, with the range of the moved point. `scan_pixel(i)` and
+// `model_pixel(i)` read pixel i of the scan and of the model, each backend from its own layout (the model
+// pixel's range is not read).
+template <typename ScanPixel, typename ModelPixel>
+ELO_HOST_DEVICE inline ImagePixel fusedPixel(uint32_t source, uint32_t pixels, const Rigid3f& scan_from_model,
+                                             const ScanPixel& scan_pixel, const ModelPixel& model_pixel) {
+  if (isScanSource(source, pixels)) return scan_pixel(source - pixels);
+  const ImagePixel kept = model_pixel(source);
+  const Float3 moved = scan_from_model.apply(kept.vertex);
+  return {moved, scan_from_model.rotate(kept.normal), norm(moved), kept.stamp};
+}
+
 }  // namespace elo

@@ -37,6 +37,10 @@ SphericalFusionScratch::Moved moveModelPoint(const SphericalImage& model, size_t
   return {row * projection.cols + col, norm(moved)};
 }
 
+ImagePixel pixelOf(const SphericalImage& image, size_t pixel) {
+  return {toFloat3(image.vertex[pixel]), toFloat3(image.normal[pixel]), image.range[pixel], image.stamp[pixel]};
+}
+
 }  // namespace
 
 void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, const SphericalProjection& projection,
@@ -87,19 +91,13 @@ void fuseSphericalModel(const SphericalImage& model, const ScanImage& scan, cons
       fused.normal[pixel].setZero();
       return;
     }
-    const uint32_t source = oldestWinsSource(winner);
-    if (isScanSource(source, pixels)) {
-      const size_t from = source - pixels;
-      fused.vertex[pixel] = observed.vertex[from];
-      fused.normal[pixel] = observed.normal[from];
-      fused.range[pixel] = observed.range[from];
-      fused.stamp[pixel] = observed.stamp[from];
-    } else {
-      fused.vertex[pixel] = toVec3f(scan_from_model.apply(toFloat3(model.vertex[source])));
-      fused.normal[pixel] = toVec3f(scan_from_model.rotate(toFloat3(model.normal[source])));
-      fused.range[pixel] = moved[source].range;
-      fused.stamp[pixel] = model.stamp[source];
-    }
+    const ImagePixel taken = fusedPixel(oldestWinsSource(winner), pixels, scan_from_model,
+                                        [&](uint32_t from) { return pixelOf(observed, from); },
+                                        [&](uint32_t from) { return pixelOf(model, from); });
+    fused.vertex[pixel] = toVec3f(taken.vertex);
+    fused.normal[pixel] = toVec3f(taken.normal);
+    fused.range[pixel] = taken.range;
+    fused.stamp[pixel] = taken.stamp;
   });
 }
 

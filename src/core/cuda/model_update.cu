@@ -68,21 +68,14 @@ __global__ void takeFusedWinners(ClosestKey* closest_keys, ClosestKey* surface_k
     fused.normals[pixel] = Float3{0.0f, 0.0f, 0.0f};
     return;
   }
-  const uint32_t pixels = static_cast<uint32_t>(fused.pixels());
-  const uint32_t source = oldestWinsSource(key);
-  if (isScanSource(source, pixels)) {
-    const uint32_t from = source - pixels;
-    fused.vertices[pixel] = scan.vertices[from];
-    fused.normals[pixel] = scan.normals[from];
-    fused.ranges[pixel] = scan.ranges[from];
-    fused.stamps[pixel] = scan.stamps[from];
-  } else {
-    const Float3 moved = scan_from_model.apply(model.vertices[source]);
-    fused.vertices[pixel] = moved;
-    fused.normals[pixel] = scan_from_model.rotate(model.normals[source]);
-    fused.ranges[pixel] = norm(moved);
-    fused.stamps[pixel] = model.stamps[source];
-  }
+  const ImagePixel taken = fusedPixel(
+      oldestWinsSource(key), static_cast<uint32_t>(fused.pixels()), scan_from_model,
+      [&](uint32_t from) { return ImagePixel{scan.vertices[from], scan.normals[from], scan.ranges[from], scan.stamps[from]}; },
+      [&](uint32_t from) { return ImagePixel{model.vertices[from], model.normals[from], 0.0f, model.stamps[from]}; });
+  fused.vertices[pixel] = taken.vertex;
+  fused.normals[pixel] = taken.normal;
+  fused.ranges[pixel] = taken.range;
+  fused.stamps[pixel] = taken.stamp;
 }
 
 __global__ void copyJoiningPixels(DeviceScan scan, DeviceModelImage model) {
