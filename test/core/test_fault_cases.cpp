@@ -104,6 +104,31 @@ void expectSkippedAndHarmless(const PointCloud& faulty, const std::string& what)
   }
 }
 
+// The fallback of the projection (docs/robustness.md#a-lost-track): a sweep deskewed under a velocity that
+// throws its points out of the image is projected again as measured, not skipped. With the motion bounds
+// off, a scan stamped 10 us after the first and taken 0.5 m higher registers as 50 km/s upwards; the next
+// sweep, deskewed under that (its points moved up to 2.5 km), keeps only those fired at its very middle.
+TEST(FaultCases, ASweepDeskewedOutOfTheImageIsProjectedAgainAsMeasured) {
+  Config config;
+  config.motion.max_speed = 1e9;
+  config.motion.max_turn_rate_deg = 1e9;
+  config.motion.max_acceleration = 1e9;
+  Odometry odometry(config);
+  const auto sweep = [&](double height, double stamp) {
+    return test::sweepScene(test::streetScene(), config.sensor, test::pose(-20, 0, height, 0, 0, 0), Vector6d::Zero(),
+                            stamp)
+        .cloud;
+  };
+  ASSERT_TRUE(odometry.process(sweep(0.0, 0.0)).processed);
+  const FrameResult jump = odometry.process(sweep(0.5, 1e-5));
+  ASSERT_TRUE(jump.processed && jump.refusal.empty());
+  ASSERT_GT(jump.delta.translation().z(), 0.4) << "the 0.5 m rise was not registered";
+  const FrameResult next = odometry.process(sweep(0.5, 0.1));
+  EXPECT_TRUE(next.processed) << next.skip_reason;
+  EXPECT_TRUE(next.projected_without_deskew);
+  EXPECT_TRUE(odometry.skippedCounts().empty());
+}
+
 // Registered, a single ring threw the pose off by 4.4 m, and the next scan's by 13 m, with the degeneracy
 // handling off (ring 10, facades only: the normals of collinear neighbours are arbitrary); by 4 cm with
 // it (ring 40).
