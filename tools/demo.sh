@@ -65,16 +65,9 @@ echo "plot: $out/trajectory.png"
 
 step "replaying the drive through the ROS node from a bag (headless)"
 "$bin/kitti_to_bag" --input "$out/sequence" --output "$out/sequence.bag" --poses-frame lidar >/dev/null
-set +u  # catkin's generated setup scripts read unset variables
-# shellcheck disable=SC1091
-source "$build/devel/setup.bash"
-set -u
-# A master of our own on a free port, and ROS's files under $out: nothing shared with other ROS users.
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
-export ROS_HOME="$out/ros_home"
-export ROS_LOG_DIR="$out/ros_home/log"
-mkdir -p "$ROS_LOG_DIR"
+# shellcheck source=tools/private_ros_master.sh
+source "$(dirname "$0")/private_ros_master.sh"
+private_ros_master "$build" "$out"
 # Played as fast as elo_run went (up to twice real time), with a margin: the node processes every scan,
 # and what it has not finished 15 s after the bag ends is lost when roslaunch stops it.
 scan_rate=10

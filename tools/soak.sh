@@ -44,15 +44,9 @@ elif [ "$(cat "$out/sequence/.elo_sim_args" 2>/dev/null)" != "$sim_args" ]; then
   echo "$sim_args" >"$out/sequence/.elo_sim_args"
 fi
 
-set +u  # catkin's generated setup scripts read unset variables
-# shellcheck disable=SC1091
-source "$build/devel/setup.bash"
-set -u
-# A master of our own on a free port, and logs under $out: nothing shared with other ROS users.
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
-export ROS_HOME="$out/ros_home"
-export ROS_LOG_DIR="$out/ros_home/log"
+# shellcheck source=tools/private_ros_master.sh
+source "$(dirname "$0")/private_ros_master.sh"
+private_ros_master "$build" "$out"
 
 launch_pid=""
 monitor_pid=""

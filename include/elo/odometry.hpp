@@ -100,6 +100,7 @@ class Odometry {
   Eigen::Isometry3d modelPose() const { return pose_ * stamp_in_reference_.inverse(); }
   const Config& config() const { return config_; }
   Backend& backend() { return *backend_; }
+  const Backend& backend() const { return *backend_; }
   // Why the odometry runs on another backend than runtime.backend asked for (runtime.backend_fallback);
   // empty when it runs on that one.
   const std::string& backendWarning() const { return backend_warning_; }

@@ -104,4 +104,12 @@ MapCloud readMapPcd(const std::string& path, size_t* non_finite_skipped) {
   return map;
 }
 
+PreparedMap readPreparedMap(const std::string& path, double normal_radius) {
+  size_t non_finite_skipped = 0;
+  MapCloud map = readMapPcd(path, &non_finite_skipped);
+  MapPreparation preparation = prepareMap(map, normal_radius);
+  preparation.non_finite_dropped += non_finite_skipped;  // the reader's skips: prepareMap() found none left
+  return {std::make_shared<const MapCloud>(std::move(map)), preparation};
+}
+
 }  // namespace elo

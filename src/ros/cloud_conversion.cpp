@@ -10,7 +10,13 @@ namespace {
 
 using sensor_msgs::PointField;
 
-// Appends a float32 or uint16 field at the next offset aligned to its size, as a C struct would.
+template <typename T>
+void writeField(uint8_t* point, const PointField& field, T value) {
+  std::memcpy(point + field.offset, &value, sizeof(T));
+}
+
+}  // namespace
+
 void addField(sensor_msgs::PointCloud2& message, const char* name, uint8_t datatype) {
   const uint32_t size = datatype == PointField::UINT16 ? 2 : 4;
   PointField field;
@@ -21,13 +27,6 @@ void addField(sensor_msgs::PointCloud2& message, const char* name, uint8_t datat
   message.fields.push_back(field);
   message.point_step = field.offset + size;
 }
-
-template <typename T>
-void writeField(uint8_t* point, const PointField& field, T value) {
-  std::memcpy(point + field.offset, &value, sizeof(T));
-}
-
-}  // namespace
 
 elo::PointCloud2View viewOf(const sensor_msgs::PointCloud2& message) {
   elo::PointCloud2View view;

@@ -21,6 +21,11 @@ elo::PointCloud2View viewOf(const sensor_msgs::PointCloud2& message);
 // elo::convertPointCloud2 of the message (its fields, per-point time conventions and rejections).
 ConvertedCloud fromPointCloud2(const sensor_msgs::PointCloud2& message);
 
+// Appends a float32 or uint16 field (sensor_msgs::PointField's datatype) to `message`'s point layout, at
+// the next offset aligned to its size, as a C struct would; point_step grows to hold it. Every
+// PointCloud2 the package writes lays its points out with it.
+void addField(sensor_msgs::PointCloud2& message, const char* name, uint8_t datatype);
+
 // Packs a cloud as x y z [intensity] [ring] [time]: float32, ring uint16, each field naturally aligned;
 // optional fields only when the cloud has them. The header stamp is the cloud's stamp.
 sensor_msgs::PointCloud2 toPointCloud2(const elo::PointCloud& cloud, const std::string& frame_id);

@@ -13,19 +13,11 @@ namespace {
 // The map rviz is shown, thinned: a few million points of a city map would stall it.
 constexpr size_t kMapDisplayPoints = 500000;
 
-Eigen::Isometry3d poseFromXyzYaw(const std::vector<double>& values) {
-  return Eigen::Translation3d(values[0], values[1], values[2]) *
-         Eigen::AngleAxisd(values[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ());
-}
-
 std::shared_ptr<const elo::MapCloud> loadMap(const std::string& path, const elo::Config& config) {
-  size_t non_finite_skipped = 0;
-  elo::MapCloud map = elo::readMapPcd(path, &non_finite_skipped);
-  elo::MapPreparation preparation = elo::prepareMap(map, config.localization.normal_radius);
-  preparation.non_finite_dropped += non_finite_skipped;  // the reader's skips: prepareMap() found none left
-  ROS_INFO("localization map %s: %zu points%s, %zu non-finite points dropped", path.c_str(), map.size(),
-           preparation.estimated ? ", normals estimated" : "", preparation.non_finite_dropped);
-  return std::make_shared<const elo::MapCloud>(std::move(map));
+  const elo::PreparedMap map = elo::readPreparedMap(path, config.localization.normal_radius);
+  ROS_INFO("localization map %s: %zu points%s, %zu non-finite points dropped", path.c_str(), map.cloud->size(),
+           map.preparation.estimated ? ", normals estimated" : "", map.preparation.non_finite_dropped);
+  return map.cloud;
 }
 
 // ROS order (x y z, rotation about x y z) is the core's twist order.
@@ -58,47 +50,44 @@ LocalizationSettings readLocalizationSettings(const ros::NodeHandle& private_nod
 }
 
 LocalizationFace::LocalizationFace(ros::NodeHandle& node, ros::NodeHandle& private_node,
-                                   const LocalizationSettings& settings, elo::Odometry& odometry,
-                                   std::mutex& odometry_mutex)
-    : settings_(settings),
-      odometry_mutex_(odometry_mutex),
-      localizer_(std::make_unique<elo::Localizer>(odometry, loadMap(settings.map_file, odometry.config()))) {
-  if (!settings.initial_pose.empty()) localizer_->setInitialPose(poseFromXyzYaw(settings.initial_pose));
+                                   const LocalizationSettings& settings, elo::DriveSession& session)
+    : settings_(settings), session_(session) {
+  const std::shared_ptr<const elo::MapCloud> map = loadMap(settings.map_file, session.config());
+  std::optional<Eigen::Isometry3d> initial_pose;
+  if (!settings.initial_pose.empty()) initial_pose = elo::poseFromXyzYaw(settings.initial_pose);
+  session.localizeIn(map, initial_pose);
   pose_publisher_ = node.advertise<geometry_msgs::PoseWithCovarianceStamped>("localization/pose", 10);
   map_publisher_ = node.advertise<sensor_msgs::PointCloud2>("localization/map", 1, true);
   std_msgs::Header header;
   header.frame_id = settings.map_frame;
   header.stamp = ros::Time::now();
-  map_publisher_.publish(mapCloud(localizer_->map(), kMapDisplayPoints, header));
+  map_publisher_.publish(mapCloud(*map, kMapDisplayPoints, header));
   initial_pose_subscriber_ = node.subscribe("/initialpose", 1, &LocalizationFace::onInitialPose, this);
   relocalize_service_ = private_node.advertiseService("relocalize", &LocalizationFace::onRelocalize, this);
 }
 
-LocalizationFace::Messages LocalizationFace::update(const elo::FrameResult& result, const FrameBinding& frames,
+LocalizationFace::Messages LocalizationFace::update(const elo::DriveStep& step, const FrameBinding& frames,
                                                     const ros::Time& stamp) {
+  std::unique_lock<std::mutex> lock(report_mutex_);
   frames_ = frames;
-  elo::LocalizationResult localized;
-  try {
-    localized = localizer_->update(result);
-  } catch (const std::exception& error) {
-    ROS_ERROR_THROTTLE(5.0, "localization failed on this scan, which keeps the odometry's pose: %s", error.what());
-    std::lock_guard<std::mutex> lock(report_mutex_);
+  if (!step.localization) {
+    ROS_ERROR_THROTTLE(5.0, "localization failed on this scan, which keeps the odometry's pose: %s",
+                       step.localization_failure.c_str());
     ++failed_scans_;
-    last_failure_ = error.what();
+    last_failure_ = step.localization_failure;
     return {};
   }
-  {
-    std::lock_guard<std::mutex> lock(report_mutex_);
-    last_ = localized;
-    last_failure_.clear();
-    ++scans_;
-  }
+  const elo::LocalizationResult& localized = *step.localization;
+  last_ = localized;
+  last_failure_.clear();
+  ++scans_;
+  lock.unlock();
   if (!localized.refusal.empty()) ROS_WARN_THROTTLE(5.0, "localization: match refused: %s", localized.refusal.c_str());
   Messages messages;
   if (localized.state == elo::LocalizationState::waiting_for_pose) return messages;
   // The core's frames: its odom is the sensor at the first scan; ROS's odom is the child frame there.
   const Eigen::Isometry3d map_from_sensor = localized.pose;
-  const Eigen::Isometry3d odom_from_sensor = frames.sensorPose(result.pose);
+  const Eigen::Isometry3d odom_from_sensor = frames.sensorPose(step.odometry.pose);
   geometry_msgs::TransformStamped transform = tf2::eigenToTransform(map_from_sensor * odom_from_sensor.inverse());
   transform.header.stamp = stamp;
   transform.header.frame_id = settings_.map_frame;
@@ -123,40 +112,36 @@ void LocalizationFace::onInitialPose(const geometry_msgs::PoseWithCovarianceStam
   }
   Eigen::Isometry3d map_from_child;
   tf2::fromMsg(message->pose.pose, map_from_child);
-  std::lock_guard<std::mutex> lock(odometry_mutex_);
-  const Eigen::Isometry3d base_from_sensor = frames_ ? frames_->base_from_sensor : Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d base_from_sensor = Eigen::Isometry3d::Identity();
+  {
+    std::lock_guard<std::mutex> lock(report_mutex_);
+    if (frames_) base_from_sensor = frames_->base_from_sensor;
+  }
   Eigen::Isometry3d hint = map_from_child * base_from_sensor;
   const double yaw = std::atan2(hint.rotation()(1, 0), hint.rotation()(0, 0));
   hint = Eigen::Translation3d(hint.translation().x(), hint.translation().y(), NAN) *
          Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
-  localizer_->setInitialPose(hint);
+  session_.setInitialPose(hint);
   ROS_INFO("localization: initial pose x %.2f y %.2f yaw %.1f deg from /initialpose; the next scan searches around it",
            hint.translation().x(), hint.translation().y(), yaw * 180.0 / M_PI);
 }
 
 bool LocalizationFace::onRelocalize(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  std::lock_guard<std::mutex> lock(odometry_mutex_);
-  // Not tracking: around the hint the odometry carries, at once rather than at its next periodic search.
-  if (const std::optional<elo::PoseHint> carried = localizer_->carriedHint()) {
-    localizer_->setInitialPose(carried->map_from_sensor, carried->radius, carried->yaw_deg);
-    response.success = true;
-    response.message = "the next scan searches around the pose given (or, lost, the last match's), as the odometry "
-                       "carries it";
-    return true;
+  switch (session_.relocalize()) {
+    case elo::DriveSession::Relocalization::around_carried_hint:
+      response.success = true;
+      response.message = "the next scan searches around the pose given (or, lost, the last match's), as the "
+                         "odometry carries it";
+      break;
+    case elo::DriveSession::Relocalization::no_pose_yet:
+      response.success = false;
+      response.message = "no pose in the map yet: give one (~initial_pose or /initialpose)";
+      break;
+    case elo::DriveSession::Relocalization::around_current_pose:
+      response.success = true;
+      response.message = "the next scan searches around the current pose in the map";
+      break;
   }
-  if (localizer_->state() == elo::LocalizationState::waiting_for_pose) {
-    response.success = false;
-    response.message = "no pose in the map yet: give one (~initial_pose or /initialpose)";
-    return true;
-  }
-  elo::LocalizationResult last;
-  {
-    std::lock_guard<std::mutex> report_lock(report_mutex_);
-    last = last_;
-  }
-  localizer_->setInitialPose(last.pose);
-  response.success = true;
-  response.message = "the next scan searches around the current pose in the map";
   return true;
 }
 

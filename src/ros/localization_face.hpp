@@ -1,6 +1,6 @@
 // The localization mode of the odometry nodelet (~localization_map set, docs/localization.md): each scan
-// the odometry processed is localized in the saved map with the same backend images, under the same lock,
-// so the scan is processed once. Publishes map -> odom and localization/pose; takes the initial pose from
+// the odometry processed is localized in the saved map with the same backend images, by the drive session
+// (its localization step), so the scan is processed once. Publishes map -> odom and localization/pose; takes the initial pose from
 // ~initial_pose, rviz's 2D Pose Estimate (/initialpose) and the ~relocalize service.
 #pragma once
 
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "elo/localization/localizer.hpp"
+#include "elo/drive_session.hpp"
 #include "messages.hpp"
 
 namespace elo_ros {
@@ -40,17 +40,15 @@ class LocalizationFace {
     std::optional<geometry_msgs::PoseWithCovarianceStamped> pose;
   };
 
-  // Loads the map (throws IoError or std::runtime_error, as for a backend that cannot render maps).
-  // `odometry_mutex` guards `odometry` and this face: the callbacks take it.
+  // Loads the map and has `session` localize in it (throws IoError, std::invalid_argument or
+  // std::runtime_error, as for a backend that cannot render maps).
   LocalizationFace(ros::NodeHandle& node, ros::NodeHandle& private_node, const LocalizationSettings& settings,
-                   elo::Odometry& odometry, std::mutex& odometry_mutex);
+                   elo::DriveSession& session);
 
-  // Under the odometry lock, after `odometry.process()` returned `result`. A scan the backend cannot
-  // render the map for (the CUDA backend: the map's part near the vehicle does not fit in the device's
+  // The messages of a processed scan's localization (DriveStep::localization). A scan the backend could
+  // not render the map for (the CUDA backend: the map's part near the vehicle does not fit in the device's
   // free memory) is logged, counted in the diagnostics and left unlocalized; the odometry goes on.
-  Messages update(const elo::FrameResult& result, const FrameBinding& frames, const ros::Time& stamp);
-  // Under the odometry lock: the odometry was reset by its service.
-  void odometryReset() { localizer_->odometryRestarted(); }
+  Messages update(const elo::DriveStep& step, const FrameBinding& frames, const ros::Time& stamp);
   void publish(const Messages& messages);
   // For diagnostic_updater: OK while tracking, WARN while waiting for a pose, ERROR when lost or when the
   // last scan failed.
@@ -61,10 +59,9 @@ class LocalizationFace {
   bool onRelocalize(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
 
   LocalizationSettings settings_;
-  std::mutex& odometry_mutex_;
-  std::unique_ptr<elo::Localizer> localizer_;
+  elo::DriveSession& session_;
+  std::mutex report_mutex_;  // guards what follows: the scans' thread writes it, the callbacks read it
   std::optional<FrameBinding> frames_;  // of the last localized scan, for /initialpose's base -> sensor
-  std::mutex report_mutex_;
   elo::LocalizationResult last_;
   size_t scans_ = 0;
   size_t failed_scans_ = 0;

@@ -21,16 +21,7 @@ class VertexCloud {
     message_.is_bigendian = elo::hostIsBigEndian();
     message_.is_dense = true;
     const char* names[] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
-    const int field_count = with_normals ? 6 : 3;
-    for (int i = 0; i < field_count; ++i) {
-      sensor_msgs::PointField field;
-      field.name = names[i];
-      field.offset = static_cast<uint32_t>(i * sizeof(float));
-      field.datatype = sensor_msgs::PointField::FLOAT32;
-      field.count = 1;
-      message_.fields.push_back(field);
-    }
-    message_.point_step = static_cast<uint32_t>(field_count * sizeof(float));
+    for (int i = 0; i < (with_normals ? 6 : 3); ++i) addField(message_, names[i], sensor_msgs::PointField::FLOAT32);
   }
 
   void reserve(size_t points) { message_.data.reserve(points * message_.point_step); }
@@ -114,16 +105,7 @@ sensor_msgs::PointCloud2 mapCloud(const elo::MapCloud& map, size_t max_points, c
   message.width = static_cast<uint32_t>(count);
   message.is_bigendian = elo::hostIsBigEndian();
   message.is_dense = true;
-  const char* names[] = {"x", "y", "z", "intensity"};
-  for (int i = 0; i < 4; ++i) {
-    sensor_msgs::PointField field;
-    field.name = names[i];
-    field.offset = static_cast<uint32_t>(i * sizeof(float));
-    field.datatype = sensor_msgs::PointField::FLOAT32;
-    field.count = 1;
-    message.fields.push_back(field);
-  }
-  message.point_step = 4 * sizeof(float);
+  for (const char* name : {"x", "y", "z", "intensity"}) addField(message, name, sensor_msgs::PointField::FLOAT32);
   message.row_step = message.point_step * message.width;
   message.data.resize(message.row_step);
   for (size_t n = 0; n < count; ++n) {

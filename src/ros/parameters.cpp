@@ -1,5 +1,7 @@
 #include "parameters.hpp"
 
+#include <ros/console.h>
+
 #include <algorithm>
 #include <set>
 #include <stdexcept>
@@ -153,6 +155,22 @@ std::vector<std::pair<std::string, XmlRpcValue>> effectiveParameters(elo::Config
     named_values.emplace_back(rosName(parameter.key).substr(1), toXmlRpc(parameter.get()));
   }
   return named_values;
+}
+
+elo::Config readConfig(ros::NodeHandle& private_node, const std::string& logger) {
+  XmlRpcValue tree;
+  private_node.getParam(private_node.getNamespace(), tree);
+  elo::Config config;
+  const std::vector<std::string> unknown = applyConfigParameters(tree, config);
+  if (!unknown.empty()) {
+    std::string names;
+    for (const std::string& name : unknown) names += (names.empty() ? "" : ", ") + name;
+    ROS_WARN_NAMED(logger, "unknown parameters ignored (no such odometry parameter, see config/*.yaml): %s",
+                   names.c_str());
+  }
+  elo::validate(config);
+  for (const auto& [name, value] : effectiveParameters(config)) private_node.setParam(name, value);
+  return config;
 }
 
 NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {

@@ -26,6 +26,11 @@ std::vector<std::string> applyConfigParameters(XmlRpc::XmlRpcValue tree, elo::Co
 // sets them back on the parameter server, which then shows the configuration the node runs with.
 std::vector<std::pair<std::string, XmlRpc::XmlRpcValue>> effectiveParameters(elo::Config& config);
 
+// The core's configuration from the private namespace (applyConfigParameters(); the parameters that
+// name no core parameter are warned of under `logger`), validated (throws elo::ConfigError), then set
+// back on the parameter server (effectiveParameters()).
+elo::Config readConfig(ros::NodeHandle& private_node, const std::string& logger);
+
 enum class TrajectoryFormat { kitti, tum };
 
 // Where and how the services write. The services re-read them at each call, so that `rosparam set`

@@ -260,11 +260,3 @@ TEST(NodeletFaults, ImpossibleParametersRefuseToStartNamingThemAndTheManagerCarr
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "fault_cases_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}

@@ -207,11 +207,3 @@ TEST(SimulatedBag, NodeletInManagerMatchesTheCoreInProcess) {
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_bag_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}

@@ -97,11 +97,3 @@ TEST(SimulatedDistortedBag, NodeletDeskewsByTheCloudsTimes) {
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_deskew_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}

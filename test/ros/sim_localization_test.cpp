@@ -97,11 +97,3 @@ TEST(SimulatedLocalization, LocalizesTheBagFromAnInitialPoseOnTheTopic) {
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_localization_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}

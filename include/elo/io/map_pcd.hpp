@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 
+#include "elo/localization/point_map.hpp"
 #include "elo/map_cloud.hpp"
 
 namespace elo {
@@ -22,5 +24,14 @@ void writeMapPcd(const std::string& path, const MapCloud& map);
 // skipped and counted into `non_finite_skipped`; when that is null and points were skipped, a warning
 // naming the file goes to stderr, so a skip is never silent.
 MapCloud readMapPcd(const std::string& path, size_t* non_finite_skipped = nullptr);
+
+// A map to localize in (elo_run --localize, the node's ~localization_map): read, then prepared
+// (prepareMap(): normals estimated within `normal_radius` where it has none). `preparation` says what
+// that did, the points the reader skipped counted among the non-finite ones dropped.
+struct PreparedMap {
+  std::shared_ptr<const MapCloud> cloud;
+  MapPreparation preparation;
+};
+PreparedMap readPreparedMap(const std::string& path, double normal_radius);
 
 }  // namespace elo
