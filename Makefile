@@ -138,13 +138,15 @@ gpu-check: build
 	tools/gpu_check.sh $(BUILD)/devel/lib/elo_odometry $(SHARED_DATA)/real/hdl64_drive_a
 
 # The package built and tested on Debian 11 (bullseye, the nearest twin of Noetic's Ubuntu 20.04) in a
-# debootstrap chroot cached in .compat/ (tools/compat.sh; root or sudo). COMPAT_TARGETS=core, as CI runs
-# it, builds everything as a baseline x86-64 build, runs the core tests only and writes the poses that
+# debootstrap chroot cached in .compat/bullseye (tools/compat.sh; root or sudo). COMPAT_TARGETS=core, as CI
+# runs it, builds everything as a baseline x86-64 build, runs the core tests only and writes the poses that
 # compat-poses compares; COMPAT_TARGETS=deps only makes the chroot and installs its packages (CI does
-# that first, in the background).
+# that first, in the background). COMPAT_RELEASE=trixie does the same on Debian 13 (GCC 14, CMake 3.31,
+# PCL 1.15, roscpp 1.17), in .compat/trixie.
 COMPAT_TARGETS ?= test
+COMPAT_RELEASE ?= bullseye
 compat:
-	tools/compat.sh $(COMPAT_TARGETS)
+	COMPAT_RELEASE=$(COMPAT_RELEASE) tools/compat.sh $(COMPAT_TARGETS)
 
 # The poses that `make compat COMPAT_TARGETS=core` left in .compat/poses (Debian 11's baseline x86-64
 # build: GCC 10, Eigen 3.3, no AVX, no FMA) against this machine's -march=native build's.

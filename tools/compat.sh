@@ -1,22 +1,25 @@
 #!/usr/bin/env bash
-# Builds and tests the package on Debian 11 (bullseye: GCC 10, CMake 3.18, TBB 2020, PCL 1.11, roscpp 1.15
-# as on Noetic), in a chroot made with debootstrap, from a clean copy of this tree (what git tracks or
-# would track: no build directories), with the `make deps` and `make` targets a user runs. Root only (it
-# mounts; sudo is used when not root). Usage:
-#   tools/compat.sh [MAKE_TARGET... | core]
+# Builds and tests the package on an older or newer Debian than the machine's, in a chroot made with
+# debootstrap, from a clean copy of this tree (what git tracks or would track: no build directories), with
+# the `make deps` and `make` targets a user runs. The release is COMPAT_RELEASE: bullseye by default
+# (Debian 11: GCC 10, CMake 3.18, TBB 2020, PCL 1.11, roscpp 1.15 as on Noetic; what CI runs), or trixie
+# (Debian 13: GCC 14, CMake 3.31, PCL 1.15, Boost 1.83, roscpp 1.17), or any release Debian's mirror and
+# this machine's debootstrap know. Root only (it mounts; sudo is used when not root). Usage:
+#   [COMPAT_RELEASE=trixie] tools/compat.sh [MAKE_TARGET... | core]
 # MAKE_TARGET defaults to `test`. `core` is CI's share of the run: everything built as a baseline x86-64
 # build (-DELO_NATIVE=OFF: no AVX, no FMA), the core tests (ctest -L core), and elo_run's poses on the
 # shared real scans written to COMPAT_CACHE/poses (tools/poses_of.sh), which `make compat-poses` compares
-# with this machine's -march=native build's. Environment: COMPAT_CACHE (default .compat/ in the tree,
-# ignored by git: the chroot, kept between runs so that a second run needs no download), COMPAT_MIRROR
-# (default Debian's, deb.debian.org), JOBS (default nproc). The shared data (../shared/data) is mounted
-# read-only when present.
+# with this machine's -march=native build's. Environment: COMPAT_RELEASE (default bullseye), COMPAT_CACHE
+# (default .compat/ in the tree, ignored by git: one chroot per release, COMPAT_CACHE/<release>, kept
+# between runs so that a second run needs no download), COMPAT_MIRROR (default Debian's, deb.debian.org),
+# JOBS (default nproc). The shared data (../shared/data) is mounted read-only when present.
 set -euo pipefail
 tree="$(cd "$(dirname "$0")/.." && pwd)"
 cache=${COMPAT_CACHE:-$tree/.compat}
 mirror=${COMPAT_MIRROR:-http://deb.debian.org/debian}
 jobs=${JOBS:-$(nproc)}
-chroot_dir="$cache/bullseye"
+release=${COMPAT_RELEASE:-bullseye}
+chroot_dir="$cache/$release"
 src="/src/elo_odometry"  # the tree's copy, inside the chroot; ../shared/data beside it as in a checkout
 shared="$tree/../shared/data"
 targets=("${@:-test}")
@@ -31,10 +34,10 @@ step() {
 # interrupted run leaves no half-made chroot behind to be taken for a cached one.
 if [ ! -x "$chroot_dir/usr/bin/apt-get" ]; then
   command -v debootstrap >/dev/null || $sudo apt-get -o DPkg::Lock::Timeout=900 install -y -qq debootstrap
-  step "debootstrap bullseye from $mirror into $chroot_dir"
+  step "debootstrap $release from $mirror into $chroot_dir"
   $sudo rm -rf "$chroot_dir.partial"
   mkdir -p "$cache"
-  $sudo debootstrap --variant=minbase --include=make bullseye "$chroot_dir.partial" "$mirror"
+  $sudo debootstrap --variant=minbase --include=make "$release" "$chroot_dir.partial" "$mirror"
   # A throwaway system: no fsync per file, no manuals or recommended extras (make deps names every
   # package the build and the tests need): apt takes less time in it.
   echo force-unsafe-io | $sudo tee "$chroot_dir.partial/etc/dpkg/dpkg.cfg.d/90elo-unsafe-io" >/dev/null
@@ -43,7 +46,7 @@ if [ ! -x "$chroot_dir/usr/bin/apt-get" ]; then
   $sudo mv "$chroot_dir.partial" "$chroot_dir"
 fi
 
-# The chroot holds bullseye's ROS packages: catkin and rospack, which crawl the source tree (and a
+# The chroot holds its release's ROS packages: catkin and rospack, which crawl the source tree (and a
 # workspace's src/), must not take them for packages of the workspace.
 touch "$cache/CATKIN_IGNORE" "$cache/rospack_nosubdirs"
 
@@ -69,8 +72,13 @@ mount_into /sys -t sysfs sysfs
 mount_into /dev --bind /dev
 mount_into /dev/pts --bind /dev/pts
 $sudo cp /etc/resolv.conf "$chroot_dir/etc/resolv.conf"
-# debootstrap writes no /etc/hosts, and roslaunch must resolve localhost.
+# debootstrap writes no /etc/hosts, and roslaunch must resolve localhost. The machine's own name too (the
+# chroot shares the hostname), which roslaunch looks up: without it the lookup goes to DNS, and issue 40's
+# trixie run had rostests that could not reach their own master (in the network namespace the lookup fails
+# at once, and they passed without it). Checked on every run: a cached chroot may outlive the hostname.
 grep -qs localhost "$chroot_dir/etc/hosts" || printf '127.0.0.1 localhost\n::1 localhost\n' | $sudo tee -a "$chroot_dir/etc/hosts" >/dev/null
+host_name=$(uname -n)
+grep -qsw -- "$host_name" "$chroot_dir/etc/hosts" || printf '127.0.1.1 %s\n' "$host_name" | $sudo tee -a "$chroot_dir/etc/hosts" >/dev/null
 if [ -d "$shared" ]; then
   mount_into /src/shared/data --bind "$shared"
   $sudo mount -o remount,ro,bind "$chroot_dir/src/shared/data"
@@ -103,7 +111,7 @@ in_chroot() {  # in_chroot [--isolated] COMMAND
     bash -c "cd $src && $1"
 }
 
-step "make deps (installs what bullseye lacks; nothing on a cached chroot)"
+step "make deps (installs what $release lacks; nothing on a cached chroot)"
 in_chroot "apt-get update -qq && make deps"
 
 if [ "${targets[*]}" = core ]; then
@@ -115,4 +123,4 @@ else
   step "make ${targets[*]}"
   in_chroot --isolated "make ${targets[*]} JOBS=$jobs"
 fi
-step "done: Debian 11 passed"
+step "done: Debian $(cat "$chroot_dir/etc/debian_version") ($release) passed"

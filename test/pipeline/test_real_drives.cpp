@@ -116,7 +116,10 @@ class RealDriveDrift : public testing::TestWithParam<DriftCase> {};
 TEST_P(RealDriveDrift, StaysWithinTodaysFigures) {
   const DriftCase& today = GetParam();
   if (!driveIsPresent(today.drive)) GTEST_SKIP() << absentMessage(today.drive);
-  const DriveRun& run = wholeDrive(today.drive);
+  // The name in a variable, not a temporary: GCC 14's -Wdangling-reference takes the reference returned
+  // (into wholeRuns()) for one into the temporary string.
+  const std::string drive = today.drive;
+  const DriveRun& run = wholeDrive(drive);
   const DriftError drift = averageDrift(kittiSegmentErrors(run.ground_truth, run.estimate, kSegmentLengths, kSegmentStep));
   std::cout << "drive " << today.drive << ": t_rel " << drift.t_rel_percent << " %, r_rel "
             << drift.r_rel_deg_per_100m << " deg/100m over " << drift.segments << " segments" << std::endl;
