@@ -6,13 +6,16 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <optional>
 #include <string>
 
 #include "elo/io/config_yaml.hpp"
+#include "elo/io/imu_file.hpp"
 #include "elo/io/kitti.hpp"
+#include "elo/sim/imu.hpp"
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/sequence_writer.hpp"
 #include "elo/sim/simulation.hpp"
@@ -103,6 +106,8 @@ struct Options {
   elo::sim::ScanFormat format = elo::sim::ScanFormat::kitti_bin;
   std::optional<std::string> bag;
   int threads = 0;
+  std::optional<elo::sim::ImuGrade> imu;
+  double imu_rate = 200.0;
 };
 
 long long parseInteger(const std::string& flag, const std::string& text, long long minimum) {
@@ -116,7 +121,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
       "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
-      "--mirror", "--gait", "--stamp-rounding"};
+      "--mirror", "--gait", "--stamp-rounding", "--imu", "--imu-rate"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -233,12 +238,33 @@ Options parseOptions(int argc, char** argv) {
     if (!named) throw UsageError("--gait expects " + joined(elo::sim::gaitNames()) + ", got '" + *gait + "'");
     spec.gait = *named;
   }
+  if (const auto grade = take("--imu")) {
+    options.imu = elo::sim::imuGradeFromName(*grade);
+    if (!options.imu) throw UsageError("--imu expects " + joined(elo::sim::imuGradeNames()) + ", got '" + *grade + "'");
+  }
+  if (const auto rate = take("--imu-rate")) {
+    options.imu_rate = elo::tools::parseNumber<double>("--imu-rate", *rate);
+    if (!(options.imu_rate > 0.0)) throw UsageError("--imu-rate must be positive");
+  }
   if (const auto rounding = take("--stamp-rounding")) {
     spec.stamp_rounding = elo::tools::parseNumber<double>("--stamp-rounding", *rounding);
     if (!(spec.stamp_rounding >= 0.0)) throw UsageError("--stamp-rounding must not be negative");
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;
+}
+
+// DIR/imu.txt, and DIR/imu.yaml: the imu.* parameters that say where the simulated IMU sits.
+void writeImu(const elo::sim::Simulation& simulation, const Options& options) {
+  elo::writeImuFile(options.output + "/imu.txt",
+                    elo::sim::simulateImu(simulation, *options.imu, options.imu_rate, options.spec.seed));
+  const auto listed = [](const std::vector<double>& values) {
+    return "[" + std::to_string(values[0]) + ", " + std::to_string(values[1]) + ", " + std::to_string(values[2]) + "]";
+  };
+  std::ofstream yaml(options.output + "/imu.yaml");
+  yaml << "# Where elo_sim's IMU sits on the sensor (docs/imu.md).\nimu:\n  enabled: true\n  position: "
+       << listed(elo::sim::imuMountPosition()) << "\n  rotation_deg: " << listed(elo::sim::imuMountRotationDeg()) << "\n";
+  if (!yaml.flush()) throw std::runtime_error("cannot write " + options.output + "/imu.yaml");
 }
 
 int run(const Options& options) {
@@ -256,6 +282,7 @@ int run(const Options& options) {
     const elo::sim::Simulation simulation(options.spec);
     summary = elo::sim::writeSequence(simulation, options.output, options.format,
                                       bag ? to_bag : elo::sim::ScanSink());
+    if (options.imu) writeImu(simulation, options);
   });
   if (bag) bag->close();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

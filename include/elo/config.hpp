@@ -259,6 +259,32 @@ struct StartSearchConfig {
   double margin = 0.02;
 };
 
+// An IMU beside the LiDAR (docs/imu.md): its gyro turns the motion prior and the deskew. Off by default,
+// and off means today's poses bit for bit.
+struct ImuConfig {
+  bool enabled = false;
+  // Where the IMU sits in the LiDAR's frame: its origin (m) and its axes as roll, pitch and yaw (deg,
+  // rotations about the LiDAR's x, y and z in that order).
+  std::vector<double> position = {0.0, 0.0, 0.0};
+  std::vector<double> rotation_deg = {0.0, 0.0, 0.0};
+  // s added to the IMU's stamps to put them on the scans' clock.
+  double time_offset = 0.0;
+  // Hz: the IMU's rate may not fall under this. Between two samples further apart than two of its
+  // periods (40 ms at 50 Hz) the gyro is not integrated: the scans there fall back to the LiDAR-only prior.
+  double min_rate_hz = 50.0;
+  // deg/s: a sample with a rate at or beyond this on any axis is taken as saturated and dropped (consumer
+  // MEMS units are built for 2000 deg/s, often set to less).
+  double gyro_limit_dps = 2000.0;
+  // rad/s, the IMU's axes: the gyro's bias at the start, subtracted from every sample.
+  std::vector<double> gyro_bias = {0.0, 0.0, 0.0};
+  // s: the gyro's bias is then estimated online against the LiDAR's registered rotations, each accepted
+  // scan moving the estimate by dt / this of its difference (the first scans by more: a mean of theirs
+  // with nine zeros before it, so that a turn-on bias is learnt within seconds). A consumer MEMS gyro's bias (0.5 deg/s) turned the deskew of a
+  // car's sweeps enough to cost r_rel a fifth; the registration's noise (about 0.1 deg/s a scan) averages out
+  // over this time. 0 keeps imu.gyro_bias as given.
+  double bias_time_constant = 10.0;
+};
+
 struct Config {
   SensorConfig sensor;
   GroundConfig ground;
@@ -272,6 +298,7 @@ struct Config {
   LocalizationConfig localization;
   MotionConfig motion;
   StartSearchConfig start_search;
+  ImuConfig imu;
 };
 
 // A parameter that YAML files, ROS parameters and command lines all set by the same dotted key

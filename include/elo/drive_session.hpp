@@ -93,6 +93,9 @@ class DriveSession {
   // A scan that could not be read or used before reaching the odometry, counted under `reason`: its line
   // repeats the last pose, and a localizer is told of it as of a skipped scan.
   DriveStep skipUnreadable(double stamp, const std::string& reason);
+  // Any thread: an IMU sample (Odometry::addImu(); imu.enabled, docs/imu.md), in time order, before the
+  // scans whose sweeps it covers.
+  void addImu(const ImuSample& sample);
   // Odometry::prefetch(): the scan a later process() call will be given.
   void prefetch(const PointCloud& cloud) { odometry_.prefetch(cloud); }
 

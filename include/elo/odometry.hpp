@@ -11,6 +11,7 @@
 #include "elo/backend.hpp"
 #include "elo/config.hpp"
 #include "elo/deskew.hpp"
+#include "elo/imu/imu_track.hpp"
 #include "elo/motion_prior.hpp"
 #include "elo/registration.hpp"
 #include "elo/sensor_height_check.hpp"
@@ -55,6 +56,9 @@ struct FrameResult {
   // The ground the scans show lies far from ground.sensor_height (SensorHeightCheck::add()); empty when
   // it does not, or was told already.
   std::string sensor_height_warning;
+  // With imu.enabled: why the gyro could not turn this scan's prior and deskew (imu_issue::), which then
+  // were the LiDAR's alone; empty when it did.
+  std::string imu_fallback;
   // Motion compensation (docs/deskew.md): where the points' times came from (none: the scan was taken as
   // instantaneous), the rounds of deskewing again with the registered motion, and why the cloud's own
   // times were not used or not all used (empty when they were, or when none were asked for).
@@ -81,6 +85,10 @@ class Odometry {
   // by an exception, only once the backend no longer reads a cloud handed to prefetch().
   FrameResult process(const PointCloud& cloud);
 
+  // An IMU sample (imu.enabled; docs/imu.md), in time order, before the scans it covers: the gyro turns
+  // the motion prior and the deskew of the scans whose sweeps and intervals its samples cover. A sample
+  // that is not finite, saturated or out of order is dropped and counted (imuDroppedCounts()).
+  void addImu(const ImuSample& sample) { imu_.add(sample); }
   // Hands over the scan a later process() call will be given, normally the call after the next one, so
   // that a device backend uploads it while the next call processes its scan (Backend::prefetch(),
   // docs/cuda.md). Only a speed-up: process() gives the same results, bit for bit, whatever was
@@ -123,6 +131,10 @@ class Odometry {
   // The sensor's height above the ground the scans show (median of recent checks); nullopt before any.
   std::optional<double> measuredSensorHeight() const { return height_check_.measured(); }
   bool lost() const { return refused_in_row_ > 0; }
+  // With imu.enabled: the scans the gyro could not turn, by FrameResult::imu_fallback, and the samples
+  // dropped, by reason.
+  const std::map<std::string, size_t>& imuFallbackCounts() const { return imu_fallbacks_; }
+  const std::map<std::string, size_t>& imuDroppedCounts() const { return imu_.droppedCounts(); }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -190,6 +202,12 @@ class Odometry {
   // `dt`, the motion becomes unknown (the next scan searches it). Returns true when the refusals in a row
   // reached motion.restart_after: the model has been restarted at that pose, for the scan to start anew.
   bool refuseRegistration(double dt, FrameResult& result);
+  // What the gyro says of the scan stamped `stamp` (imu.enabled): its rotation since the last accepted
+  // scan, between their reference instants, and its mean rate over the sweep; a fallback is counted and
+  // put in `result`. Nothing without imu.enabled.
+  GyroMotion gyroMotion(double stamp, const CloudTimes& times, FrameResult& result);
+  // `velocity` (a sweep's twist per second) turning at the gyro's rate over the scan's sweep, when known.
+  Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
   void deskewScanAgain(const Vector6d& velocity, FrameResult& result);
 
@@ -228,6 +246,9 @@ class Odometry {
   size_t refused_in_row_ = 0;
   size_t recoveries_ = 0;
   size_t tracking_restarts_ = 0;
+  ImuTrack imu_;
+  GyroMotion gyro_;  // of the scan being processed
+  std::map<std::string, size_t> imu_fallbacks_;
 };
 
 }  // namespace elo

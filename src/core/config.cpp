@@ -242,6 +242,17 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("start_search.yaw_step_deg", c.start_search.yaw_step_deg, "deg between the start search's yaws"),
       bindField("start_search.margin", c.start_search.margin,
                 "fit score within which a candidate that ended elsewhere makes a start ambiguous"),
+      bindField("imu.enabled", c.imu.enabled, "turn the motion prior and the deskew by the IMU's gyro (docs/imu.md)"),
+      bindField("imu.position", c.imu.position, "m: the IMU's origin in the LiDAR frame, [x, y, z]"),
+      bindField("imu.rotation_deg", c.imu.rotation_deg,
+                "deg: the IMU's axes in the LiDAR frame, [roll, pitch, yaw] about the LiDAR's x, y, z"),
+      bindField("imu.time_offset", c.imu.time_offset, "s added to the IMU's stamps to put them on the scans' clock"),
+      bindField("imu.min_rate_hz", c.imu.min_rate_hz,
+                "Hz: no gyro integration across a gap of more than two periods at this rate"),
+      bindField("imu.gyro_limit_dps", c.imu.gyro_limit_dps, "deg/s: a sample at or beyond this on an axis is saturated, dropped"),
+      bindField("imu.gyro_bias", c.imu.gyro_bias, "rad/s: the gyro's bias in the IMU's axes at the start, [x, y, z]"),
+      bindField("imu.bias_time_constant", c.imu.bias_time_constant,
+                "s: the gyro's bias estimated online against the registered rotations over about this long; 0: fixed"),
   };
 }
 
@@ -359,6 +370,13 @@ void validate(const Config& c) {
   require(start.max_yaw_rate_deg >= 0.0, "start_search.max_yaw_rate_deg", "must not be negative");
   require(start.yaw_step_deg > 0.0, "start_search.yaw_step_deg", "must be positive");
   require(start.margin >= 0.0, "start_search.margin", "must not be negative");
+  const ImuConfig& imu = c.imu;
+  require(imu.position.size() == 3, "imu.position", "must list 3 numbers: x, y, z");
+  require(imu.rotation_deg.size() == 3, "imu.rotation_deg", "must list 3 numbers: roll, pitch, yaw");
+  require(imu.gyro_bias.size() == 3, "imu.gyro_bias", "must list 3 numbers: x, y, z");
+  require(imu.min_rate_hz > 0.0, "imu.min_rate_hz", "must be positive");
+  require(imu.gyro_limit_dps > 0.0, "imu.gyro_limit_dps", "must be positive");
+  require(imu.bias_time_constant >= 0.0, "imu.bias_time_constant", "must not be negative");
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

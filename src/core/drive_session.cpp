@@ -122,6 +122,11 @@ void DriveSession::placeDriveMap(MapPlacement placement) {
   map_placement_ = std::move(placement);
 }
 
+void DriveSession::addImu(const ImuSample& sample) {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  odometry_.addImu(sample);
+}
+
 void DriveSession::reset() {
   std::lock_guard<std::mutex> lock(odometry_mutex_);
   odometry_.reset();

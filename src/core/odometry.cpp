@@ -13,7 +13,8 @@ Odometry::Odometry(const Config& config)
     : config_(config),
       motion_(config.model.motion_prior),
       guard_(config),
-      height_check_(config.ground.sensor_height) {
+      height_check_(config.ground.sensor_height),
+      imu_(config.imu) {
   validate(config_);
   backend_ = makeBackend(config_, &backend_warning_);
 }
@@ -97,7 +98,7 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool inform
     // only to replace that model.
     if (model_provisional_ && !converged) return false;
     const int rounds = model_provisional_ ? 1 : config_.deskew.rounds;
-    const Vector6d velocity = sweepVelocity(estimate, dt);
+    const Vector6d velocity = withGyroRate(sweepVelocity(estimate, dt));
     if (result.deskew_rounds >= rounds || !changesRegistration(deskewed_under, velocity, farthest, config_.registration)) {
       return false;
     }
@@ -113,9 +114,30 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool inform
 }
 
 Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
-  if (motion_.known() || !config_.start_search.enabled) return motion_.predict(dt);
-  searchMotion(dt, result);
-  return result.start_search.motion;
+  Eigen::Isometry3d guess = motion_.predict(dt);
+  if (!motion_.known() && config_.start_search.enabled) {
+    searchMotion(dt, result);
+    guess = result.start_search.motion;
+  }
+  if (gyro_.known) guess.linear() = gyro_.rotation;
+  return guess;
+}
+
+GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResult& result) {
+  if (!config_.imu.enabled) return {};
+  const double reference = stamp + times.reference;
+  const double half_sweep = 0.5 / config_.sensor.rotation_rate_hz;
+  const double previous_reference = started_ ? last_stamp_ + last_reference_ : reference;
+  GyroMotion gyro = imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep);
+  if (!gyro.fallback.empty()) ++imu_fallbacks_[gyro.fallback];
+  result.imu_fallback = gyro.fallback;
+  imu_.forgetBefore(previous_reference - half_sweep);
+  return gyro;
+}
+
+Vector6d Odometry::withGyroRate(Vector6d velocity) const {
+  if (gyro_.known) velocity.tail<3>() = gyro_.sweep_rate;
+  return velocity;
 }
 
 size_t Odometry::projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
@@ -169,6 +191,7 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
   ++refusals_[result.refusal];
   ++refused_in_row_;
   result.delta = expSE3(held_velocity_ * dt);
+  if (gyro_.known) result.delta.linear() = gyro_.rotation;
   result.pose = pose_ * result.delta;
   motion_.reset();
   if (refused_in_row_ < static_cast<size_t>(config_.motion.restart_after)) return false;
@@ -237,7 +260,8 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
 
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
-  Vector6d sweep_velocity = started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero();
+  gyro_ = gyroMotion(cloud.stamp, times, result);
+  Vector6d sweep_velocity = withGyroRate(started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero());
   const size_t occupied = projectDeskewed(cloud, relative_stamp, times, sweep_velocity, result);
   result.times.projection = millisecondsSince(stage_start);
   if (occupied < minOccupiedPixels()) {
@@ -279,6 +303,9 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     } else {
       reference_delta = result.registration.model_from_scan;
       stamp_in_reference = acceptRegistration(reference_delta, dt, deskewed_under, times, result);
+      if (gyro_.known && result.registration.converged && !result.registration.degeneracy.any()) {
+        imu_.learnBias(gyro_.rotation, reference_delta.linear(), dt);
+      }
     }
   }
 

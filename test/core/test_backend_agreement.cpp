@@ -431,6 +431,38 @@ TEST(BackendAgreement, RefusalsAndRecoveriesAgree) {
   EXPECT_EQ(odometry.cuda.recoveryCount(), odometry.cpu.recoveryCount());
 }
 
+// With an IMU (docs/imu.md) the gyro turns the guess and the deskew; the backends deskew and register
+// under the same velocities, so they agree as without it.
+TEST(BackendAgreement, PosesAgreeWithTheGyro) {
+  ELO_REQUIRE_CUDA();
+  Config config;
+  config.imu.enabled = true;
+  config.model.mode = RegistrationMode::frame_to_model;
+  config.runtime.threads = 2;
+  Odometry cpu(config);
+  config.runtime.backend = BackendKind::cuda;
+  Odometry cuda(config);
+  Vector6d velocity;
+  velocity << 10.0, 0.0, 0.0, 0.0, 0.0, 0.3;
+  for (int sample = -40; sample <= 200; ++sample) {
+    ImuSample gyro;
+    gyro.stamp = 0.005 * sample;
+    gyro.angular_velocity = velocity.tail<3>();
+    cpu.addImu(gyro);
+    cuda.addImu(gyro);
+  }
+  for (int frame = 0; frame < 8; ++frame) {
+    const Eigen::Isometry3d truth = pose(-25, 0, 0, 0, 0, 0) * expSE3(0.1 * frame * velocity);
+    const PointCloud cloud = test::sweepScene(test::streetScene(), config.sensor, truth, velocity, 0.1 * frame).cloud;
+    const FrameResult a = cpu.process(cloud);
+    const FrameResult b = cuda.process(cloud);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    EXPECT_EQ(a.imu_fallback, "");
+    EXPECT_EQ(b.imu_fallback, "");
+    expectAgreeingPoses(a.pose, b.pose, frame);
+  }
+}
+
 TEST(BackendAgreement, RealScansAgreeStageByStageAndInPose) {
   ELO_REQUIRE_CUDA();
   if (!std::filesystem::is_directory(kRealScans)) {

@@ -424,3 +424,23 @@ TEST_F(EloRunCli, MapIsWrittenAtTheEndAndWhenTheRunFailsPartWay) {
   EXPECT_GT(before_failure, 5000u) << "the map of the scans before the failure";
   EXPECT_LT(before_failure, whole) << "one scan fewer";
 }
+
+// The IMU from a directory (docs/imu.md): elo_sim --imu writes imu.txt and imu.yaml, elo_run takes the
+// sensor's configuration and imu.yaml over it (--config twice) and turns every scan by the gyro; with
+// imu.enabled and no imu.txt it stops, saying where it looked.
+TEST_F(EloRunCli, ImuTxtBesideTheScansTurnsEveryScan) {
+  const std::string drive = directory_.file("imu_drive");
+  const CommandResult simulated = runCommand(std::string(ELO_SIM_TOOL) +
+                                             " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 "
+                                             "--threads 2 --imu consumer --output " + drive);
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  ASSERT_TRUE(fs::is_regular_file(drive + "/imu.txt"));
+  const CommandResult with_imu = runEloRunOn(drive, poses(), "--config " + drive + "/imu.yaml");
+  ASSERT_EQ(with_imu.exit_code, 0) << with_imu.output;
+  EXPECT_TRUE(contains(with_imu.output, "every scan turned by the IMU")) << with_imu.output;
+  EXPECT_EQ(lines(poses()).size(), 6u);
+  fs::remove(drive + "/imu.txt");
+  const CommandResult without_file = runEloRunOn(drive, poses(), "--config " + drive + "/imu.yaml");
+  EXPECT_NE(without_file.exit_code, 0);
+  EXPECT_TRUE(contains(without_file.output, "imu.txt")) << without_file.output;
+}

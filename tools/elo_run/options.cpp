@@ -42,7 +42,8 @@ writes the poses of the scans before the failure.
 
 options:
   --topic NAME         the bag's cloud topic (default: its only PointCloud2 topic)
-  --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config)
+  --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config); given again,
+                       each file over the ones before (a sensor's, then elo_sim's imu.yaml)
   --mode f2m|f2f       frame-to-model (default) or frame-to-frame
   --threads N          CPU threads (default: all)
   --backend cpu|cuda   compute backend (runtime.backend; default cpu)
@@ -90,7 +91,7 @@ Options parseArguments(int argc, char** argv) {
     } else if (arguments.is("--output")) {
       options.output = arguments.value();
     } else if (arguments.is("--config")) {
-      options.config_file = arguments.value();
+      options.config_files.push_back(arguments.value());
     } else if (arguments.is("--mode")) {
       const std::string mode = arguments.value();
       if (mode != "f2m" && mode != "f2f") throw UsageError("--mode must be f2m or f2f, got '" + mode + "'");
@@ -150,7 +151,7 @@ Options parseArguments(int argc, char** argv) {
 
 Config loadConfig(const Options& options) {
   elo::Config config;
-  if (!options.config_file.empty()) elo::loadConfigYaml(options.config_file, config);
+  for (const std::string& file : options.config_files) elo::loadConfigYaml(file, config);
   std::vector<elo::Parameter> table = elo::parameters(config);
   for (const auto& [key, text] : options.overrides) {
     const auto parameter = std::find_if(table.begin(), table.end(), [&](const auto& p) { return p.key == key; });

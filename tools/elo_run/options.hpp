@@ -18,7 +18,7 @@ struct Options {
   std::string input;
   std::string topic;
   std::string output;
-  std::string config_file;
+  std::vector<std::string> config_files;  // applied in order
   std::string timing_csv;
   std::string tum_output;
   std::string camera_output;
@@ -38,7 +38,7 @@ struct Options {
 
 // Throws UsageError (command_line.hpp) for flags that cannot work together or values that cannot be used.
 Options parseArguments(int argc, char** argv);
-// The defaults, --config's file, then --set and the flags that stand for parameters; validated.
+// The defaults, --config's files in order, then --set and the flags that stand for parameters; validated.
 Config loadConfig(const Options& options);
 // --camera-output, or POSES with _camera before its extension.
 std::string cameraOutputPath(const Options& options);

@@ -38,6 +38,20 @@ void printTrackingHealth(const Odometry& odometry) {
   if (odometry.lost()) std::printf(", LOST at the end (the last registration was refused)");
 }
 
+// With imu.enabled: the scans the gyro could not turn and the samples dropped, by reason.
+void printImuHealth(const Odometry& odometry) {
+  if (!odometry.config().imu.enabled) return;
+  size_t fallbacks = 0;
+  for (const auto& [reason, count] : odometry.imuFallbackCounts()) {
+    std::printf(", %zu on the LiDAR-only prior (%s)", count, reason.c_str());
+    fallbacks += count;
+  }
+  if (fallbacks == 0) std::printf(", every scan turned by the IMU");
+  for (const auto& [reason, count] : odometry.imuDroppedCounts()) {
+    std::printf(", %zu IMU sample%s dropped (%s)", count, count > 1 ? "s" : "", reason.c_str());
+  }
+}
+
 // The scans counted: processed, skipped (unreadable, or unusable to the odometry), degenerate, started in
 // motion, refused, misfitting the sensor.
 void printCounts(const DriveSession& session, size_t scans) {
@@ -62,6 +76,7 @@ void printCounts(const DriveSession& session, size_t scans) {
     }
   }
   printTrackingHealth(odometry);
+  printImuHealth(odometry);
   if (odometry.sensorMisfitCount() > 0) {
     std::printf(", %zu not fitting the sensor model (the warning above)", odometry.sensorMisfitCount());
   }

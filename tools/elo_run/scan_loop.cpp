@@ -40,7 +40,11 @@ void showProgress(size_t done, size_t total) {
 }  // namespace
 
 ScanLoop::ScanLoop(const Options& options, const ScanSource& source, DriveSession& session)
-    : options_(options), source_(source), session_(session), report_(options.prefetch) {
+    : options_(options),
+      source_(source),
+      session_(session),
+      imu_(options.input, session.config()),
+      report_(options.prefetch) {
   if (session.localizer() != nullptr) localization_report_.emplace(session.localizer()->state());
   if (options.timing_csv.empty()) return;
   timing_.open(options.timing_csv);
@@ -82,6 +86,7 @@ DriveStep ScanLoop::step(const PlayedScan& played, const ScanRead& read) {
   const size_t scan = played.index;
   if (!read.scan) return skipUnreadable(scan, played.stamp, read);
   warnOnce(scan, read.scan->warning);
+  imu_.feedUpTo(played.stamp, session_);
   const DriveStep step = session_.process(read.scan->cloud);
   tellOdometry(scan, step.odometry);
   report_.add(step);
@@ -112,6 +117,7 @@ void ScanLoop::tellOdometry(size_t scan, const FrameResult& result) {
                  result.tracking_restart ? "; model restarted from this scan" : "");
   }
   if (result.recovered) std::fprintf(stderr, "\nscan %zu: tracking recovered\n", scan);
+  if (!result.imu_fallback.empty()) std::fprintf(stderr, "\nscan %zu: LiDAR-only prior: %s\n", scan, result.imu_fallback.c_str());
   if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
   if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);
   if (result.gap_restart) {

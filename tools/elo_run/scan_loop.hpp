@@ -10,6 +10,7 @@
 
 #include "elo/drive_session.hpp"
 #include "elo/io/scan_source.hpp"
+#include "imu_feed.hpp"
 #include "localization_output.hpp"
 #include "options.hpp"
 #include "run_report.hpp"
@@ -26,7 +27,7 @@ struct ScanRead {
 
 class ScanLoop {
  public:
-  // Throws IoError when --timing's file cannot be written.
+  // Throws IoError when --timing's file cannot be written, or imu.enabled has no imu.txt to read.
   ScanLoop(const Options& options, const ScanSource& source, DriveSession& session);
 
   // Reads and processes every played scan. A scan that cannot be read is skipped (its line repeats the
@@ -54,6 +55,7 @@ class ScanLoop {
   const Options& options_;
   const ScanSource& source_;
   DriveSession& session_;
+  ImuFeed imu_;
   std::ofstream timing_;
   RunReport report_;
   std::optional<LocalizationReport> localization_report_;

@@ -1,0 +1,85 @@
+// The IMU's samples the odometry holds, and what it reads of them (docs/imu.md): the LiDAR's rotation
+// between two instants by the integrated gyro, and its mean turn rate over a sweep, in the LiDAR's frame.
+// A rigid mount turns both sensors alike, so only the mount's rotation matters here, not its offset.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <deque>
+#include <map>
+#include <string>
+
+#include "elo/config.hpp"
+
+namespace elo {
+
+// One sample, as `imu.txt` lines and sensor_msgs/Imu give it.
+struct ImuSample {
+  double stamp = 0.0;  // s on the IMU's clock (imu.time_offset puts it on the scans')
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s, IMU axes
+  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();    // m/s^2, gravity included, IMU axes
+};
+
+// Why a sample was dropped, or why the gyro could not turn a scan (a fallback to the LiDAR-only prior):
+// the keys of ImuTrack::droppedCounts() and of Odometry::imuFallbackCounts().
+namespace imu_issue {
+inline constexpr char kNotFinite[] = "IMU sample not finite";
+inline constexpr char kOutOfOrder[] = "IMU sample out of order";
+inline constexpr char kClockJump[] = "IMU clock went back over a second: samples before it forgotten";
+inline constexpr char kSaturated[] = "IMU sample saturated (imu.gyro_limit_dps)";
+inline constexpr char kNotCovered[] = "no IMU samples over the scan";
+inline constexpr char kGap[] = "IMU gap over the scan (imu.min_rate_hz)";
+}  // namespace imu_issue
+
+// What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
+// instants) and its mean rate over the scan's sweep, in the LiDAR's frame. Known when the samples cover
+// both; else `fallback` says why (empty without imu.enabled).
+struct GyroMotion {
+  bool known = false;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d sweep_rate = Eigen::Vector3d::Zero();  // rad/s
+  std::string fallback;
+};
+
+class ImuTrack {
+ public:
+  explicit ImuTrack(const ImuConfig& config);
+
+  // Takes a sample; returns empty, or why it was dropped (counted in droppedCounts()). A sample over a
+  // second before the last one (a bag played again) restarts the track from it, counted as kClockJump.
+  std::string add(const ImuSample& sample);
+  // The LiDAR frame at `to` in the LiDAR frame at `from` (s, the scans' clock, from <= to), its rotation
+  // only, by the gyro integrated with its rate linear between samples, into `rotation`. Returns why it
+  // cannot be, or empty: samples must lie at or before `from` and at or after `to`, none of them further
+  // apart than two periods at imu.min_rate_hz.
+  std::string rotation(double from, double to, Eigen::Matrix3d& rotation) const;
+  // rotation() between the reference instants of two scans, and meanRate() over the later one's sweep.
+  GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to) const;
+  // Moves the gyro's bias estimate towards what makes its rotation `gyro` (from rotation()) over `dt`
+  // seconds the registered rotation `registered` (both the LiDAR's), by imu.bias_time_constant.
+  void learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt);
+  // The gyro's bias estimated online (rad/s, the IMU's axes), on top of imu.gyro_bias.
+  const Eigen::Vector3d& learntBias() const { return learnt_bias_; }
+  // Forgets the samples before `stamp` (the scans' clock) but the last one at or before it.
+  void forgetBefore(double stamp);
+  void clear() { samples_.clear(); }
+
+  const std::map<std::string, size_t>& droppedCounts() const { return dropped_; }
+  size_t size() const { return samples_.size(); }
+
+ private:
+  double max_gap_;
+  double gyro_limit_;  // rad/s
+  double time_offset_;
+  Eigen::Vector3d gyro_bias_;
+  Eigen::Matrix3d lidar_from_imu_;
+  double bias_time_constant_;
+  Eigen::Vector3d learnt_bias_ = Eigen::Vector3d::Zero();
+  size_t bias_updates_ = 0;
+  std::deque<ImuSample> samples_;  // the scans' clock, bias removed, in time order
+  std::map<std::string, size_t> dropped_;
+};
+
+// The IMU's axes in the LiDAR frame from imu.rotation_deg (roll, pitch, yaw about x, y, z).
+Eigen::Matrix3d lidarFromImuRotation(const ImuConfig& config);
+
+}  // namespace elo

@@ -1,0 +1,125 @@
+#include "elo/imu/imu_track.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace elo {
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kClockJump = 1.0;  // s a sample may lie before the last one before it restarts the track
+// The bias estimate starts as a mean of the first scans' with this many zeros before them: no one
+// registration, the first after a start least of all, sets it alone.
+constexpr size_t kBiasPriorScans = 9;
+
+Eigen::Vector3d vectorOf(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
+
+Eigen::Matrix3d rotationOf(const Eigen::Vector3d& turn) {
+  const double angle = turn.norm();
+  return angle > 0.0 ? Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+}
+
+Eigen::Vector3d turnOf(const Eigen::Matrix3d& rotation) {
+  const Eigen::AngleAxisd angle_axis(rotation);
+  return angle_axis.angle() * angle_axis.axis();
+}
+
+bool finite(const ImuSample& sample) {
+  return std::isfinite(sample.stamp) && sample.angular_velocity.allFinite() && sample.specific_force.allFinite();
+}
+
+}  // namespace
+
+Eigen::Matrix3d lidarFromImuRotation(const ImuConfig& config) {
+  const Eigen::Vector3d rpy = vectorOf(config.rotation_deg) * kDegToRad;
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+ImuTrack::ImuTrack(const ImuConfig& config)
+    : max_gap_(2.0 / config.min_rate_hz),
+      gyro_limit_(config.gyro_limit_dps * kDegToRad),
+      time_offset_(config.time_offset),
+      gyro_bias_(config.gyro_bias.size() == 3 ? vectorOf(config.gyro_bias) : Eigen::Vector3d::Zero()),
+      lidar_from_imu_(config.rotation_deg.size() == 3 ? lidarFromImuRotation(config) : Eigen::Matrix3d::Identity()),
+      bias_time_constant_(config.bias_time_constant) {}
+
+std::string ImuTrack::add(const ImuSample& sample) {
+  std::string issue;
+  if (!finite(sample)) {
+    issue = imu_issue::kNotFinite;
+  } else if (sample.angular_velocity.cwiseAbs().maxCoeff() >= gyro_limit_) {
+    issue = imu_issue::kSaturated;
+  } else if (!samples_.empty() && sample.stamp + time_offset_ <= samples_.back().stamp) {
+    // Far behind: a bag played again or a clock reset, as the odometry's reset() takes a scan stamped
+    // before the last; the samples held describe another time.
+    if (sample.stamp + time_offset_ < samples_.back().stamp - kClockJump) {
+      samples_.clear();
+      ++dropped_[imu_issue::kClockJump];
+    } else {
+      issue = imu_issue::kOutOfOrder;
+    }
+  }
+  if (!issue.empty()) {
+    ++dropped_[issue];
+    return issue;
+  }
+  ImuSample taken = sample;
+  taken.stamp += time_offset_;
+  taken.angular_velocity -= gyro_bias_;
+  samples_.push_back(taken);
+  return {};
+}
+
+std::string ImuTrack::rotation(double from, double to, Eigen::Matrix3d& rotation) const {
+  const auto before = [](const ImuSample& sample, double time) { return sample.stamp < time; };
+  if (samples_.empty() || samples_.front().stamp > from || samples_.back().stamp < to) return imu_issue::kNotCovered;
+  // The last sample at or before `from`, then every interval between samples up to `to`, each integrated
+  // over its part within [from, to] by the mean of the rates (linear between the samples) at its ends.
+  size_t i = static_cast<size_t>(std::lower_bound(samples_.begin(), samples_.end(), from, before) - samples_.begin());
+  if (i == samples_.size() || samples_[i].stamp > from) --i;
+  Eigen::Matrix3d imu_rotation = Eigen::Matrix3d::Identity();
+  for (; i + 1 < samples_.size() && samples_[i].stamp < to; ++i) {
+    const double t0 = samples_[i].stamp;
+    const double t1 = samples_[i + 1].stamp;
+    if (t1 - t0 > max_gap_) return imu_issue::kGap;
+    const double a = std::max(from, t0);
+    const double b = std::min(to, t1);
+    if (b <= a) continue;
+    const Eigen::Vector3d& w0 = samples_[i].angular_velocity;
+    const Eigen::Vector3d& w1 = samples_[i + 1].angular_velocity;
+    const auto rate = [&](double t) -> Eigen::Vector3d { return w0 + (w1 - w0) * ((t - t0) / (t1 - t0)) - learnt_bias_; };
+    imu_rotation = imu_rotation * rotationOf(0.5 * (rate(a) + rate(b)) * (b - a));
+  }
+  rotation = lidar_from_imu_ * imu_rotation * lidar_from_imu_.transpose();
+  return {};
+}
+
+GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, double sweep_from,
+                                double sweep_to) const {
+  GyroMotion motion;
+  Eigen::Matrix3d over_sweep;
+  motion.fallback = rotation(previous_reference, reference, motion.rotation);
+  if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
+  motion.known = motion.fallback.empty();
+  if (motion.known) motion.sweep_rate = turnOf(over_sweep) / (sweep_to - sweep_from);
+  return motion;
+}
+
+void ImuTrack::learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt) {
+  if (bias_time_constant_ <= 0.0 || dt <= 0.0) return;
+  // The gyro turned by `gyro` where the LiDAR turned by `registered`: its rate was high by the rotation
+  // between them over dt, in the IMU's axes.
+  const Eigen::Vector3d excess = lidar_from_imu_.transpose() * turnOf(registered.transpose() * gyro) / dt;
+  ++bias_updates_;
+  const double gain = std::max(1.0 / static_cast<double>(bias_updates_ + kBiasPriorScans), dt / bias_time_constant_);
+  learnt_bias_ += gain * excess;
+}
+
+void ImuTrack::forgetBefore(double stamp) {
+  while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
+}
+
+}  // namespace elo
