@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "elo/localization/localizer.hpp"
-#include "elo/map_builder.hpp"
+#include "elo/map/map_builder.hpp"
 #include "elo/odometry.hpp"
 
 namespace elo {

@@ -258,9 +258,10 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   const double stamp_interval = since_first - last_since_first_ + (times.reference - last_reference_);
   const double dt = started_ ? motionInterval(stamp_interval, times.source, config_.sensor) : 0.0;
 
-  auto stage_start = Clock::now();
-  // Deskewed under the velocity last registered: the first scans (none yet) as they were measured.
   gyro_ = gyroMotion(cloud.stamp, times, result);
+  auto stage_start = Clock::now();
+  // Deskewed under the velocity last registered: the first scans (none yet) as they were measured. With an
+  // IMU, turning at the gyro's rate over the sweep.
   Vector6d sweep_velocity = withGyroRate(started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero());
   const size_t occupied = projectDeskewed(cloud, relative_stamp, times, sweep_velocity, result);
   result.times.projection = millisecondsSince(stage_start);

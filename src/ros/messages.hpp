@@ -10,7 +10,7 @@
 #include <Eigen/Geometry>
 #include <optional>
 
-#include "elo/map_cloud.hpp"
+#include "elo/map/map_cloud.hpp"
 #include "elo/odometry.hpp"
 #include "elo/types.hpp"
 

@@ -13,7 +13,7 @@
 #include "analytic_scene.hpp"
 #include "elo/io/sequence.hpp"
 #include "elo/localization/localizer.hpp"
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 #include "elo/odometry.hpp"
 
 namespace elo {

@@ -7,8 +7,8 @@
 #include <future>
 #include <random>
 
-#include "elo/drive_map.hpp"
-#include "elo/map_builder.hpp"
+#include "elo/map/drive_map.hpp"
+#include "elo/map/map_builder.hpp"
 
 namespace elo {
 namespace {

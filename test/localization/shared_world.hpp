@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 #include "elo/sim/lidar.hpp"
 #include "elo/sim/rng.hpp"
 #include "elo/sim/trajectory.hpp"

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <cstdio>
 
-#include "core/localization/map_residency.hpp"
+#include "core/map/map_residency.hpp"
 #include "elo/localization/localizer.hpp"
 #include "elo/sim/sensors.hpp"
 #include "shared_world.hpp"

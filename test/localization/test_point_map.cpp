@@ -13,8 +13,8 @@
 #include "elo/backend.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/map_pcd.hpp"
-#include "core/localization/map_residency.hpp"
-#include "elo/localization/point_map.hpp"
+#include "core/map/map_residency.hpp"
+#include "elo/map/point_map.hpp"
 
 namespace elo {
 namespace {

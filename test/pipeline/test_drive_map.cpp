@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "elo/drive_map.hpp"
+#include "elo/map/drive_map.hpp"
 #include "elo/odometry.hpp"
 #include "elo/sim/simulation.hpp"
 

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "elo/localization/point_map.hpp"
-#include "elo/map_cloud.hpp"
+#include "elo/map/point_map.hpp"
+#include "elo/map/map_cloud.hpp"
 
 namespace elo {
 

@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 #include "elo/odometry.hpp"
 
 namespace elo {

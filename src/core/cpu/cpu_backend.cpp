@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 
 namespace elo::cpu {
 

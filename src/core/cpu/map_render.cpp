@@ -5,7 +5,7 @@
 #include "core/common/normals.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 
 namespace elo::cpu {
 

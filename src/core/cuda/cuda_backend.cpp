@@ -8,7 +8,7 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/common/term_sums.hpp"
 #include "core/elapsed_time.hpp"
-#include "elo/map_cloud.hpp"
+#include "elo/map/map_cloud.hpp"
 #include "elo/sensor_model.hpp"
 
 namespace elo::cuda {

@@ -14,7 +14,7 @@
 #include "core/cuda/device_buffer.hpp"
 #include "core/double_buffered_upload.hpp"
 #include "core/cuda/kernels.hpp"
-#include "core/localization/map_residency.hpp"
+#include "core/map/map_residency.hpp"
 #include "elo/backend.hpp"
 
 namespace elo::cuda {

@@ -1,4 +1,4 @@
-#include "core/localization/map_residency.hpp"
+#include "core/map/map_residency.hpp"
 
 #include <algorithm>
 

@@ -9,7 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "elo/map_cloud.hpp"
+#include "elo/map/map_cloud.hpp"
 
 namespace elo {
 

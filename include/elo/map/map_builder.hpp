@@ -10,7 +10,7 @@
 #include <mutex>
 #include <thread>
 
-#include "elo/drive_map.hpp"
+#include "elo/map/drive_map.hpp"
 
 namespace elo {
 

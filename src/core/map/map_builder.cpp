@@ -1,4 +1,4 @@
-#include "elo/map_builder.hpp"
+#include "elo/map/map_builder.hpp"
 
 #include <algorithm>
 

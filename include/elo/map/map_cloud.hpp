@@ -1,5 +1,5 @@
 // A map as points: what the drive's map gives (DriveMap::points()), what a map file holds
-// (io/map_pcd.hpp), and what localization matches scans against (localization/point_map.hpp).
+// (io/map_pcd.hpp), and what localization matches scans against (map/point_map.hpp).
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "elo/drive_map.hpp"
+#include "elo/map/drive_map.hpp"
 
 #include <algorithm>
 #include <cmath>

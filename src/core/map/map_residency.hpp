@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 
 namespace elo {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
-#include "elo/map_cloud.hpp"
+#include "elo/map/map_cloud.hpp"
 #include "elo/types.hpp"
 
 namespace elo {

@@ -1,4 +1,4 @@
-#include "elo/localization/point_map.hpp"
+#include "elo/map/point_map.hpp"
 
 #include <tbb/parallel_for.h>
 
