@@ -13,7 +13,7 @@
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/scan_source.hpp"
-#include "elo/sensor_fit.hpp"
+#include "elo/sensor/sensor_fit.hpp"
 #include "elo_run/localization_output.hpp"
 #include "elo_run/map_output.hpp"
 #include "elo_run/options.hpp"

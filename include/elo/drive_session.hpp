@@ -15,7 +15,7 @@
 
 #include "elo/localization/localizer.hpp"
 #include "elo/map/map_builder.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 

@@ -1,4 +1,4 @@
-#include "elo/degeneracy.hpp"
+#include "elo/pipeline/degeneracy.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>

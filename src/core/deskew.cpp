@@ -1,4 +1,4 @@
-#include "elo/deskew.hpp"
+#include "elo/pipeline/deskew.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "elo/motion_prior.hpp"
+#include "elo/pipeline/motion_prior.hpp"
 
 namespace elo {
 

@@ -1,11 +1,11 @@
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 #include <cmath>
 
 #include "core/elapsed_time.hpp"
-#include "elo/deskew.hpp"
+#include "elo/pipeline/deskew.hpp"
 #include "elo/se3.hpp"
-#include "elo/sensor_fit.hpp"
+#include "elo/sensor/sensor_fit.hpp"
 
 namespace elo {
 

@@ -1,4 +1,4 @@
-#include "elo/registration.hpp"
+#include "elo/pipeline/registration.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "elo/sensor_fit.hpp"
+#include "elo/sensor/sensor_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include "core/common/eigen_interop.hpp"
 #include "core/median.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 namespace elo {
 

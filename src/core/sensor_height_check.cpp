@@ -1,4 +1,4 @@
-#include "elo/sensor_height_check.hpp"
+#include "elo/sensor/sensor_height_check.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 #include <algorithm>
 

@@ -1,11 +1,11 @@
-#include "elo/start_search.hpp"
+#include "elo/pipeline/start_search.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "core/elapsed_time.hpp"
-#include "elo/registration.hpp"
+#include "elo/pipeline/registration.hpp"
 
 namespace elo {
 namespace {

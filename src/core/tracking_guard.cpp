@@ -1,4 +1,4 @@
-#include "elo/tracking_guard.hpp"
+#include "elo/pipeline/tracking_guard.hpp"
 
 #include <cmath>
 #include <vector>

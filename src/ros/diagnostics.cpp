@@ -140,7 +140,7 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("ground inlier ratio", last.ground.inlierRatio());
   status.add("fusion weight", last_registration_.weight);
   status.add("registration iterations", last_registration_.iterations);
-  // Share of the constraint along the least constrained direction (see elo/degeneracy.hpp).
+  // Share of the constraint along the least constrained direction (see elo/pipeline/degeneracy.hpp).
   status.add("smallest constraint eigenvalue", degeneracy.eigenvalues[0]);
   status.add("degenerate directions", degeneracy.any() ? degeneracy.describe() : "none");
   status.add("clouds received", received_);

@@ -9,7 +9,7 @@
 #include <mutex>
 #include <string>
 
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo_ros {
 

@@ -11,7 +11,7 @@
 #include <optional>
 
 #include "elo/map/map_cloud.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/types.hpp"
 
 namespace elo_ros {

@@ -3,7 +3,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "cloud_conversion.hpp"
-#include "elo/sensor_fit.hpp"
+#include "elo/sensor/sensor_fit.hpp"
 
 namespace elo_ros {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 #include "elo/sim/rng.hpp"
 
 namespace elo::sim {

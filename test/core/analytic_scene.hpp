@@ -11,7 +11,7 @@
 
 #include "elo/config.hpp"
 #include "elo/se3.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 #include "elo/types.hpp"
 
 namespace elo::test {

@@ -14,7 +14,7 @@
 #include "elo/io/sequence.hpp"
 #include "elo/localization/localizer.hpp"
 #include "elo/map/point_map.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "analytic_scene.hpp"
-#include "elo/degeneracy.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/degeneracy.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

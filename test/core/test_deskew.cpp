@@ -12,8 +12,8 @@
 #include "core/common/eigen_interop.hpp"
 #include "core/cpu/deskew_lanes.hpp"
 #include "core/cpu/stages.hpp"
-#include "elo/deskew.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/deskew.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

@@ -8,7 +8,7 @@
 #include <chrono>
 
 #include "analytic_scene.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

@@ -11,7 +11,7 @@
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 
 namespace elo {
 namespace {

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "analytic_scene.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "elo/motion_prior.hpp"
+#include "elo/pipeline/motion_prior.hpp"
 #include "elo/se3.hpp"
 
 namespace elo {

@@ -1,11 +1,11 @@
-// The check that a cloud fits the configured sensor (elo/sensor_fit.hpp), on points placed at known
+// The check that a cloud fits the configured sensor (elo/sensor/sensor_fit.hpp), on points placed at known
 // elevations and rings.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "elo/sensor_fit.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_fit.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 namespace elo {
 namespace {

@@ -26,7 +26,7 @@
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/packed_sums.hpp"
 #include "core/cuda/normal_tile.hpp"
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 
 namespace elo {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "elo/tracking_guard.hpp"
+#include "elo/pipeline/tracking_guard.hpp"
 
 namespace elo {
 namespace {

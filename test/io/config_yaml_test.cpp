@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "elo/io/io_error.hpp"
-#include "elo/projections.hpp"
-#include "elo/sensor_fit.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/projections.hpp"
+#include "elo/sensor/sensor_fit.hpp"
+#include "elo/sensor/sensor_model.hpp"
 #include "temp_directory.hpp"
 #include "test_helpers.hpp"
 

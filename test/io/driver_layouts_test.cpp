@@ -16,7 +16,7 @@
 #include <functional>
 
 #include "elo/config.hpp"
-#include "elo/deskew.hpp"
+#include "elo/pipeline/deskew.hpp"
 #include "elo/io/point_cloud2.hpp"
 
 namespace {

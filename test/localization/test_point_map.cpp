@@ -10,7 +10,7 @@
 #include <numeric>
 #include <random>
 
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/map_pcd.hpp"
 #include "core/map/map_residency.hpp"

@@ -13,7 +13,7 @@
 #include <unordered_set>
 
 #include "elo/map/drive_map.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/sim/simulation.hpp"
 
 namespace elo {

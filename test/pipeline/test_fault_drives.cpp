@@ -9,7 +9,7 @@
 #include <map>
 #include <mutex>
 
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/sim/simulation.hpp"
 
 namespace elo {

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 #include "elo/sim/simulation.hpp"
 
 namespace elo {

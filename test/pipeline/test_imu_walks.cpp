@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "elo/eval/kitti_metric.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/sim/imu.hpp"
 #include "simulated_walks.hpp"
 

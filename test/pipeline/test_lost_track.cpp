@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "elo/eval/kitti_metric.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "simulated_walks.hpp"
 
 namespace elo {

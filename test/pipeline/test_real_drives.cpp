@@ -18,7 +18,7 @@
 #include "elo/eval/trajectory_error.hpp"
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/sequence.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

@@ -10,7 +10,7 @@
 #include "elo/eval/kitti_metric.hpp"
 #include "elo/eval/trajectory_error.hpp"
 #include "elo/io/sequence.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 namespace {

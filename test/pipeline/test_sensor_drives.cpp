@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "elo/eval/evaluation.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/simulation.hpp"
 

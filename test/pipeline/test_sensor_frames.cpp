@@ -17,8 +17,8 @@
 
 #include "elo/io/config_yaml.hpp"
 #include "elo/io/pcd.hpp"
-#include "elo/sensor_fit.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_fit.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 namespace elo {
 namespace {

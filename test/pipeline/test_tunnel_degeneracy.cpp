@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "elo/eval/evaluation.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 #include "elo/sim/simulation.hpp"
 
 namespace elo {

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "elo/io/sequence.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo_ros_test {
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 #include "elo/sim/lidar.hpp"
 
 namespace elo::sim::test {

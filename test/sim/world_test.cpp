@@ -10,7 +10,7 @@
 #include "../io/temp_directory.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 #include "elo/sim/sensors.hpp"
 #include "elo/sim/sequence_writer.hpp"
 #include "elo/sim/simulation.hpp"

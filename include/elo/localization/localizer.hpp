@@ -11,7 +11,7 @@
 #include <string>
 
 #include "elo/map/point_map.hpp"
-#include "elo/odometry.hpp"
+#include "elo/pipeline/odometry.hpp"
 
 namespace elo {
 

@@ -11,7 +11,7 @@
 
 #include "core/common/plane_fit.hpp"
 #include "elo/config.hpp"
-#include "elo/projections.hpp"
+#include "elo/sensor/projections.hpp"
 
 namespace elo {
 

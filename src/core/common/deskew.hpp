@@ -9,7 +9,7 @@
 
 #include "elo/config.hpp"
 #include "elo/device_types.hpp"
-#include "elo/projections.hpp"  // fastAtan2
+#include "elo/sensor/projections.hpp"  // fastAtan2
 
 namespace elo {
 

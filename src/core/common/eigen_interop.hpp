@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 
 #include "core/common/deskew.hpp"
-#include "elo/backend.hpp"  // SweepMotion
+#include "elo/pipeline/backend.hpp"  // SweepMotion
 #include "elo/device_types.hpp"
 #include "elo/types.hpp"
 

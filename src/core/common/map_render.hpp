@@ -7,7 +7,7 @@
 
 #include "elo/config.hpp"
 #include "elo/device_types.hpp"
-#include "elo/projections.hpp"
+#include "elo/sensor/projections.hpp"
 
 namespace elo {
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "core/common/deskew.hpp"
-#include "elo/projections.hpp"
+#include "elo/sensor/projections.hpp"
 
 namespace elo {
 

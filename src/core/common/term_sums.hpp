@@ -2,7 +2,7 @@
 #pragma once
 
 #include "core/common/point_to_plane.hpp"
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 
 namespace elo {
 

@@ -9,7 +9,7 @@
 #include <cstddef>
 
 #include "elo/device_types.hpp"
-#include "elo/projections.hpp"
+#include "elo/sensor/projections.hpp"
 
 #if defined(__AVX__)
 #define ELO_PIXEL_LANES 1

@@ -13,8 +13,8 @@
 #include "core/common/normals.hpp"
 #include "core/common/scan_projection.hpp"
 #include "core/cpu/closest_wins.hpp"
-#include "elo/backend.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/pipeline/backend.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 namespace elo::cpu {
 

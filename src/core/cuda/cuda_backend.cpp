@@ -9,7 +9,7 @@
 #include "core/common/term_sums.hpp"
 #include "core/elapsed_time.hpp"
 #include "elo/map/map_cloud.hpp"
-#include "elo/sensor_model.hpp"
+#include "elo/sensor/sensor_model.hpp"
 
 namespace elo::cuda {
 

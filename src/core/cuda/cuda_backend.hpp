@@ -15,7 +15,7 @@
 #include "core/double_buffered_upload.hpp"
 #include "core/cuda/kernels.hpp"
 #include "core/map/map_residency.hpp"
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 
 namespace elo::cuda {
 

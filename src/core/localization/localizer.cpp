@@ -7,8 +7,8 @@
 
 #include "core/common/map_render.hpp"
 #include "core/elapsed_time.hpp"
-#include "elo/degeneracy.hpp"
-#include "elo/registration.hpp"
+#include "elo/pipeline/degeneracy.hpp"
+#include "elo/pipeline/registration.hpp"
 
 namespace elo {
 namespace {

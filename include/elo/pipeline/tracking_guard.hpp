@@ -10,7 +10,7 @@
 #include <string>
 
 #include "elo/config.hpp"
-#include "elo/registration.hpp"
+#include "elo/pipeline/registration.hpp"
 
 namespace elo {
 

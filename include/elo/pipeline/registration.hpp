@@ -3,8 +3,8 @@
 
 #include <functional>
 
-#include "elo/backend.hpp"
-#include "elo/degeneracy.hpp"
+#include "elo/pipeline/backend.hpp"
+#include "elo/pipeline/degeneracy.hpp"
 
 namespace elo {
 

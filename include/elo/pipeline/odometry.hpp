@@ -8,15 +8,15 @@
 #include <optional>
 #include <string>
 
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 #include "elo/config.hpp"
-#include "elo/deskew.hpp"
+#include "elo/pipeline/deskew.hpp"
 #include "elo/imu/imu_track.hpp"
-#include "elo/motion_prior.hpp"
-#include "elo/registration.hpp"
-#include "elo/sensor_height_check.hpp"
-#include "elo/start_search.hpp"
-#include "elo/tracking_guard.hpp"
+#include "elo/pipeline/motion_prior.hpp"
+#include "elo/pipeline/registration.hpp"
+#include "elo/sensor/sensor_height_check.hpp"
+#include "elo/pipeline/start_search.hpp"
+#include "elo/pipeline/tracking_guard.hpp"
 
 namespace elo {
 

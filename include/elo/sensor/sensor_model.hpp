@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
-#include "elo/projections.hpp"
+#include "elo/sensor/projections.hpp"
 #include "elo/types.hpp"
 
 namespace elo {

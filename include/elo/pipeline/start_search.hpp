@@ -13,7 +13,7 @@
 
 #include <Eigen/Geometry>
 
-#include "elo/backend.hpp"
+#include "elo/pipeline/backend.hpp"
 #include "elo/config.hpp"
 
 namespace elo {
