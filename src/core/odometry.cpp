@@ -114,8 +114,10 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool inform
 }
 
 Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
-  Eigen::Isometry3d guess = motion_.predict(dt);
-  if (!motion_.known() && config_.start_search.enabled) {
+  Eigen::Isometry3d guess;
+  if (motion_.known() || !config_.start_search.enabled) {
+    guess = motion_.predict(dt);
+  } else {
     searchMotion(dt, result);
     guess = result.start_search.motion;
   }

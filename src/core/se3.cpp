@@ -36,6 +36,11 @@ Eigen::Isometry3d expSE3(const Vector6d& twist) {
   return transform;
 }
 
+Eigen::Vector3d logSO3(const Eigen::Matrix3d& rotation) {
+  const Eigen::AngleAxisd angle_axis(rotation);
+  return angle_axis.angle() * angle_axis.axis();
+}
+
 Vector6d logSE3(const Eigen::Isometry3d& transform) {
   const Eigen::AngleAxisd angle_axis(transform.linear());
   const double angle = angle_axis.angle();

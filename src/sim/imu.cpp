@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "elo/se3.hpp"
 #include "elo/sim/rng.hpp"
 #include "elo/sim/simulation.hpp"
 
@@ -14,11 +15,6 @@ constexpr double kStandardGravity = 9.81;  // m/s^2
 constexpr double kMicroG = 9.81e-6;        // m/s^2
 constexpr double kStep = 1e-3;             // s: the central differences' half step
 
-Eigen::Vector3d turnOf(const Eigen::Matrix3d& rotation) {
-  const Eigen::AngleAxisd angle_axis(rotation);
-  return angle_axis.angle() * angle_axis.axis();
-}
-
 Eigen::Vector3d gaussianVector(Rng& rng, double stddev) {
   return {rng.gaussian(0.0, stddev), rng.gaussian(0.0, stddev), rng.gaussian(0.0, stddev)};
 }
@@ -30,7 +26,7 @@ ImuSample trueSample(const std::function<Eigen::Isometry3d(double)>& imu_pose_at
   const Eigen::Isometry3d after = imu_pose_at(t + kStep);
   ImuSample sample;
   sample.stamp = t;
-  sample.angular_velocity = turnOf(before.linear().transpose() * after.linear()) / (2.0 * kStep);
+  sample.angular_velocity = logSO3(before.linear().transpose() * after.linear()) / (2.0 * kStep);
   const Eigen::Vector3d acceleration =
       (after.translation() - 2.0 * now.translation() + before.translation()) / (kStep * kStep);
   sample.specific_force = now.linear().transpose() * (acceleration + Eigen::Vector3d(0.0, 0.0, kStandardGravity));

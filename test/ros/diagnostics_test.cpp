@@ -22,12 +22,19 @@ elo::FrameResult processedScan(double total_ms) {
   return result;
 }
 
-TEST(RosDiagnostics, QuietWindowIsOk) {
-  elo_ros::PipelineStatistics statistics;
+// The status reported after one more cloud received and processed as `result`, 65 ms after it arrived.
+diagnostic_updater::DiagnosticStatusWrapper statusAfterScan(elo_ros::PipelineStatistics& statistics,
+                                                            const elo::FrameResult& result) {
   statistics.cloudReceived();
-  statistics.scanProcessed(processedScan(60.0), 65.0);
+  statistics.scanProcessed(result, 65.0);
   diagnostic_updater::DiagnosticStatusWrapper status;
   statistics.report(status);
+  return status;
+}
+
+TEST(RosDiagnostics, QuietWindowIsOk) {
+  elo_ros::PipelineStatistics statistics;
+  const diagnostic_updater::DiagnosticStatusWrapper status = statusAfterScan(statistics, processedScan(60.0));
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
   EXPECT_EQ(valueOf(status, "processing time mean (ms)"), "60");
   EXPECT_EQ(valueOf(status, "latency max (ms)"), "65");
@@ -40,18 +47,12 @@ TEST(RosDiagnostics, StartSearchesAreCountedAndAnAmbiguousOneWarns) {
   elo_ros::PipelineStatistics statistics;
   elo::FrameResult searched = processedScan(60.0);
   searched.start_search.searched = true;
-  statistics.cloudReceived();
-  statistics.scanProcessed(searched, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper clear;
-  statistics.report(clear);
+  const diagnostic_updater::DiagnosticStatusWrapper clear = statusAfterScan(statistics, searched);
   EXPECT_EQ(clear.level, diagnostic_msgs::DiagnosticStatus::OK) << clear.message;
   EXPECT_EQ(valueOf(clear, "start searches"), "1");
 
   searched.start_search.ambiguous = true;
-  statistics.cloudReceived();
-  statistics.scanProcessed(searched, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper ambiguous;
-  statistics.report(ambiguous);
+  const diagnostic_updater::DiagnosticStatusWrapper ambiguous = statusAfterScan(statistics, searched);
   EXPECT_EQ(ambiguous.level, diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_NE(ambiguous.message.find("1 ambiguous start"), std::string::npos) << ambiguous.message;
   EXPECT_EQ(valueOf(ambiguous, "start searches"), "2");
@@ -63,20 +64,14 @@ TEST(RosDiagnostics, ARefusedRegistrationIsAnErrorUntilTheTrackRecovers) {
   elo_ros::PipelineStatistics statistics;
   elo::FrameResult refused = processedScan(60.0);
   refused.refusal = elo::refusal::kAccelerates;
-  statistics.cloudReceived();
-  statistics.scanProcessed(refused, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper lost;
-  statistics.report(lost);
+  const diagnostic_updater::DiagnosticStatusWrapper lost = statusAfterScan(statistics, refused);
   EXPECT_EQ(lost.level, diagnostic_msgs::DiagnosticStatus::ERROR) << lost.message;
   EXPECT_NE(lost.message.find("lost"), std::string::npos) << lost.message;
   EXPECT_EQ(valueOf(lost, std::string("registrations refused: ") + elo::refusal::kAccelerates), "1");
 
   elo::FrameResult recovered = processedScan(60.0);
   recovered.recovered = true;
-  statistics.cloudReceived();
-  statistics.scanProcessed(recovered, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper again;
-  statistics.report(again);
+  const diagnostic_updater::DiagnosticStatusWrapper again = statusAfterScan(statistics, recovered);
   EXPECT_EQ(again.level, diagnostic_msgs::DiagnosticStatus::OK) << again.message;
   EXPECT_EQ(valueOf(again, "recoveries"), "1");
 }
@@ -117,10 +112,7 @@ TEST(RosDiagnostics, UnusablePerPointTimesWarnAndAreCountedByReason) {
   elo_ros::PipelineStatistics statistics;
   elo::FrameResult instantaneous = processedScan(60.0);
   instantaneous.time_warning = "no per-point times: taken as instantaneous";
-  statistics.cloudReceived();
-  statistics.scanProcessed(instantaneous, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper status;
-  statistics.report(status);
+  const diagnostic_updater::DiagnosticStatusWrapper status = statusAfterScan(statistics, instantaneous);
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_NE(status.message.find("1 scans with unusable per-point times"), std::string::npos) << status.message;
   EXPECT_EQ(valueOf(status, "per-point times: no per-point times: taken as instantaneous"), "1");
@@ -131,19 +123,13 @@ TEST(RosDiagnostics, DegenerateScansWarnWhileTheyLastAndAreCounted) {
   elo::FrameResult tunnel = processedScan(60.0);
   elo::Matrix6d hessian = (elo::Vector6d() << 0, 1, 1, 50, 50, 50).finished().asDiagonal();  // x unconstrained
   tunnel.registration.degeneracy = *elo::analyseDegeneracy(hessian, 0.005);
-  statistics.cloudReceived();
-  statistics.scanProcessed(tunnel, 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper inside;
-  statistics.report(inside);
+  const diagnostic_updater::DiagnosticStatusWrapper inside = statusAfterScan(statistics, tunnel);
   EXPECT_EQ(inside.level, diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_EQ(inside.message, "latest scan degenerate along x");
   EXPECT_EQ(valueOf(inside, "degenerate directions"), "x");
   EXPECT_EQ(valueOf(inside, "scans degenerate"), "1");
 
-  statistics.cloudReceived();
-  statistics.scanProcessed(processedScan(60.0), 65.0);
-  diagnostic_updater::DiagnosticStatusWrapper outside;
-  statistics.report(outside);
+  const diagnostic_updater::DiagnosticStatusWrapper outside = statusAfterScan(statistics, processedScan(60.0));
   EXPECT_EQ(outside.level, diagnostic_msgs::DiagnosticStatus::OK) << outside.message;
   EXPECT_EQ(valueOf(outside, "degenerate directions"), "none");
   EXPECT_EQ(valueOf(outside, "scans degenerate"), "1") << "the total stays";

@@ -8,8 +8,8 @@
 namespace elo::tools {
 
 ImuFeed::ImuFeed(const std::string& input, const Config& config)
-    : enabled_(config.imu.enabled), sweep_(1.0 / config.sensor.rotation_rate_hz), time_offset_(config.imu.time_offset) {
-  if (!enabled_) return;
+    : sweep_(1.0 / config.sensor.rotation_rate_hz), time_offset_(config.imu.time_offset) {
+  if (!config.imu.enabled) return;
   const std::filesystem::path file = std::filesystem::path(input) / "imu.txt";
   if (!std::filesystem::is_regular_file(file)) {
     throw IoError("imu.enabled, but " + file.string() +

@@ -17,11 +17,8 @@ class ImuFeed {
 
   // Hands `session` every sample not handed yet up to a sweep after `stamp` (the scan's).
   void feedUpTo(double stamp, DriveSession& session);
-  bool enabled() const { return enabled_; }
-  size_t sampleCount() const { return samples_.size(); }
 
  private:
-  bool enabled_;
   double sweep_;       // s
   double time_offset_;  // imu.time_offset
   std::vector<ImuSample> samples_;

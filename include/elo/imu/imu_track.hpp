@@ -61,7 +61,6 @@ class ImuTrack {
   const Eigen::Vector3d& learntBias() const { return learnt_bias_; }
   // Forgets the samples before `stamp` (the scans' clock) but the last one at or before it.
   void forgetBefore(double stamp);
-  void clear() { samples_.clear(); }
 
   const std::map<std::string, size_t>& droppedCounts() const { return dropped_; }
   size_t size() const { return samples_.size(); }

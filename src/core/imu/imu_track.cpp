@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "elo/se3.hpp"
+
 namespace elo {
 
 namespace {
@@ -18,11 +20,6 @@ Eigen::Vector3d vectorOf(const std::vector<double>& values) { return {values[0],
 Eigen::Matrix3d rotationOf(const Eigen::Vector3d& turn) {
   const double angle = turn.norm();
   return angle > 0.0 ? Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
-}
-
-Eigen::Vector3d turnOf(const Eigen::Matrix3d& rotation) {
-  const Eigen::AngleAxisd angle_axis(rotation);
-  return angle_axis.angle() * angle_axis.axis();
 }
 
 bool finite(const ImuSample& sample) {
@@ -104,7 +101,7 @@ GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, dou
   motion.fallback = rotation(previous_reference, reference, motion.rotation);
   if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
   motion.known = motion.fallback.empty();
-  if (motion.known) motion.sweep_rate = turnOf(over_sweep) / (sweep_to - sweep_from);
+  if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
   return motion;
 }
 
@@ -112,7 +109,7 @@ void ImuTrack::learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& reg
   if (bias_time_constant_ <= 0.0 || dt <= 0.0) return;
   // The gyro turned by `gyro` where the LiDAR turned by `registered`: its rate was high by the rotation
   // between them over dt, in the IMU's axes.
-  const Eigen::Vector3d excess = lidar_from_imu_.transpose() * turnOf(registered.transpose() * gyro) / dt;
+  const Eigen::Vector3d excess = lidar_from_imu_.transpose() * logSO3(registered.transpose() * gyro) / dt;
   ++bias_updates_;
   const double gain = std::max(1.0 / static_cast<double>(bias_updates_ + kBiasPriorScans), dt / bias_time_constant_);
   learnt_bias_ += gain * excess;
