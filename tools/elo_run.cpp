@@ -70,6 +70,9 @@ std::unique_ptr<DriveSession> startSession(const Options& options, const Config&
 void printSummary(const Options& options, DriveSession& session, const ScanLoop& loop, size_t scans,
                   double wall_seconds) {
   loop.report().print(session, scans, loop.nonFinitePoints(), wall_seconds);
+  for (const auto& [reason, count] : loop.imu().skippedMessages()) {
+    std::printf("IMU: %zu message%s skipped (%s)\n", count, count > 1 ? "s" : "", reason.c_str());
+  }
   if (session.driveMap()) {
     std::printf("%s\n", writeDriveMap(session, options.map_output).c_str());
     const auto [copy_ms, add_ms] = mapCostPerScan(session);

@@ -93,7 +93,10 @@ std::string usage() {
          "                       a second); default none (a vehicle)\n"
          "  --imu " + joined(elo::sim::imuGradeNames()) + "\n"
          "                       also write DIR/imu.txt, the samples of an IMU of that grade bolted to the\n"
-         "                       sensor, and DIR/imu.yaml, the imu.* parameters of its mount (docs/imu.md)\n"
+         "                       sensor, and DIR/imu.yaml, the imu.* parameters of its mount (docs/imu.md);\n"
+         "                       with --bag, the samples as sensor_msgs/Imu on /imu (frame imu), the mount\n"
+         "                       as velodyne -> imu on /tf_static, and each cloud recorded once its sweep\n"
+         "                       and the samples over it are out\n"
          "  --imu-rate HZ        the IMU's samples a second (default 200)\n"
          "  --stamp-rounding S   record the stamps rounded to S seconds (times.txt, the scans, the bag), as\n"
          "                       KITTI-raw's are to 0.01; the ground truth stays at the true instants\n"
@@ -258,10 +261,16 @@ Options parseOptions(int argc, char** argv) {
   return options;
 }
 
-// DIR/imu.txt, and DIR/imu.yaml: the imu.* parameters that say where the simulated IMU sits.
-void writeImu(const elo::sim::Simulation& simulation, const Options& options) {
-  elo::writeImuFile(options.output + "/imu.txt",
-                    elo::sim::simulateImu(simulation, *options.imu, options.imu_rate, options.spec.seed));
+// DIR/imu.txt, and DIR/imu.yaml: the imu.* parameters that say where the simulated IMU sits; with --bag,
+// the samples on its /imu and the mount on its /tf_static.
+void writeImu(const elo::sim::Simulation& simulation, const Options& options, elo_ros::SequenceBagWriter* bag) {
+  const std::vector<elo::ImuSample> samples =
+      elo::sim::simulateImu(simulation, *options.imu, options.imu_rate, options.spec.seed);
+  elo::writeImuFile(options.output + "/imu.txt", samples);
+  if (bag && !samples.empty()) {
+    bag->writeImuMount(elo::sim::simulatedImuMount(), samples.front().stamp);
+    for (const elo::ImuSample& sample : samples) bag->write(sample);
+  }
   const auto listed = [](const std::vector<double>& values) {
     return "[" + std::to_string(values[0]) + ", " + std::to_string(values[1]) + ", " + std::to_string(values[2]) + "]";
   };
@@ -271,6 +280,20 @@ void writeImu(const elo::sim::Simulation& simulation, const Options& options) {
   if (!yaml.flush()) throw std::runtime_error("cannot write " + options.output + "/imu.yaml");
 }
 
+// With an IMU, each cloud is recorded when a driver would publish it: after the sweep's end, the instant
+// up to which the odometry integrates the gyro over it (mid-sweep, where the stamp is for azimuth times
+// and instantaneous scans, plus half a sweep), and the IMU's next sample. Played back, a node then has the
+// samples over a sweep when its cloud comes.
+elo_ros::SequenceBagOptions bagOptions(const Options& options) {
+  elo_ros::SequenceBagOptions bag;
+  if (!options.imu) return bag;
+  const bool stamped_at_start =
+      !options.spec.lidar.deskewed && options.spec.lidar.time_convention == elo::sim::TimeConvention::field;
+  bag.cloud_record_delay =
+      (stamped_at_start ? 1.0 : 0.5) / options.spec.config.sensor.rotation_rate_hz + 1.0 / options.imu_rate;
+  return bag;
+}
+
 int run(const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -278,7 +301,7 @@ int run(const Options& options) {
   // --bag: the scans go to the bag as they are simulated, with the ring and any per-point times that
   // the KITTI .bin files cannot hold.
   std::optional<elo_ros::SequenceBagWriter> bag;
-  if (options.bag) bag.emplace(*options.bag, elo_ros::SequenceBagOptions());
+  if (options.bag) bag.emplace(*options.bag, bagOptions(options));
   const elo::sim::ScanSink to_bag = [&bag](const elo::sim::SimulatedScan& scan, const Eigen::Isometry3d& pose) {
     bag->write(scan.cloud, pose);
   };
@@ -286,7 +309,7 @@ int run(const Options& options) {
     const elo::sim::Simulation simulation(options.spec);
     summary = elo::sim::writeSequence(simulation, options.output, options.format,
                                       bag ? to_bag : elo::sim::ScanSink());
-    if (options.imu) writeImu(simulation, options);
+    if (options.imu) writeImu(simulation, options, bag ? &*bag : nullptr);
   });
   if (bag) bag->close();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -96,6 +96,9 @@ class DriveSession {
   // Any thread: an IMU sample (Odometry::addImu(); imu.enabled, docs/imu.md), in time order, before the
   // scans whose sweeps it covers.
   void addImu(const ImuSample& sample);
+  // Any thread: Odometry::setImuMount() (the node's mount from TF), and Odometry::imuStatus().
+  void setImuMount(const std::vector<double>& position, const std::vector<double>& rotation_deg);
+  ImuStatus imuStatus() const;
   // Odometry::prefetch(): the scan a later process() call will be given.
   void prefetch(const PointCloud& cloud) { odometry_.prefetch(cloud); }
 

@@ -127,6 +127,16 @@ void DriveSession::addImu(const ImuSample& sample) {
   odometry_.addImu(sample);
 }
 
+void DriveSession::setImuMount(const std::vector<double>& position, const std::vector<double>& rotation_deg) {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  odometry_.setImuMount(position, rotation_deg);
+}
+
+ImuStatus DriveSession::imuStatus() const {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  return odometry_.imuStatus();
+}
+
 void DriveSession::reset() {
   std::lock_guard<std::mutex> lock(odometry_mutex_);
   odometry_.reset();

@@ -137,6 +137,23 @@ GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResu
   return gyro;
 }
 
+void Odometry::setImuMount(const std::vector<double>& position, const std::vector<double>& rotation_deg) {
+  config_.imu.position = position;
+  config_.imu.rotation_deg = rotation_deg;
+  validate(config_);
+  imu_.setMount(config_.imu);
+}
+
+ImuStatus Odometry::imuStatus() const {
+  ImuStatus status;
+  status.enabled = config_.imu.enabled;
+  status.samples_taken = imu_.takenCount();
+  status.dropped = imu_.droppedCounts();
+  status.fallbacks = imu_fallbacks_;
+  status.gyro_bias = imu_.biasEstimate();
+  return status;
+}
+
 Vector6d Odometry::withGyroRate(Vector6d velocity) const {
   if (gyro_.known) velocity.tail<3>() = gyro_.sweep_rate;
   return velocity;

@@ -3,12 +3,27 @@
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace elo_ros {
 namespace {
 
 double mean(double sum, size_t count) { return count > 0 ? sum / count : 0.0; }
+
+size_t total(const std::map<std::string, size_t>& counts) {
+  size_t sum = 0;
+  for (const auto& [reason, count] : counts) sum += count;
+  return sum;
+}
+
+std::string degreesPerSecond(const Eigen::Vector3d& rate) {
+  std::ostringstream text;
+  text.precision(4);
+  const Eigen::Vector3d degrees = rate * 180.0 / M_PI;
+  text << degrees.x() << ", " << degrees.y() << ", " << degrees.z();
+  return text.str();
+}
 
 }  // namespace
 
@@ -162,6 +177,65 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   if (sensor_misfits_ > 0) status.add("sensor model: latest misfit", last_sensor_warning_);
 
   window_start_ = now;
+  window_ = Window();
+}
+
+void ImuStatistics::messageReceived(double stamp) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++received_;
+  if (window_.received++ == 0) window_.first_stamp = stamp;
+  window_.last_stamp = stamp;
+}
+
+void ImuStatistics::messageUnused(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++unused_[reason];
+  ++window_.unused;
+}
+
+void ImuStatistics::update(const elo::ImuStatus& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  core_ = status;
+}
+
+void ImuStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Window& w = window_;
+  const double span = w.last_stamp - w.first_stamp;
+  const double rate = w.received > 1 && span > 0.0 ? (w.received - 1) / span : 0.0;
+  const size_t fallbacks = total(core_.fallbacks);
+  const size_t dropped = total(core_.dropped);
+
+  std::ostringstream problems;
+  const auto add = [&](const std::string& problem) { problems << (problems.tellp() > 0 ? ", " : "") << problem; };
+  if (w.received == 0) {
+    add("IMU silent: no Imu message");
+  } else if (rate < min_rate_hz_) {
+    std::ostringstream text;
+    text << "IMU rate " << rate << " Hz under imu.min_rate_hz (" << min_rate_hz_ << ")";
+    add(text.str());
+  }
+  if (w.unused > 0) add(std::to_string(w.unused) + " Imu messages unused");
+  if (dropped > reported_dropped_) add(std::to_string(dropped - reported_dropped_) + " IMU samples dropped");
+  if (fallbacks > reported_fallbacks_) {
+    add(std::to_string(fallbacks - reported_fallbacks_) + " scans on the LiDAR-only prior");
+  }
+  if (problems.tellp() > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, problems.str());
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "every scan turned by the gyro");
+  }
+  status.add("IMU rate (Hz)", rate);
+  status.add("Imu messages received", received_);
+  for (const auto& [reason, count] : unused_) status.add("Imu messages unused: " + reason, count);
+  status.add("IMU samples taken", core_.samples_taken);
+  for (const auto& [reason, count] : core_.dropped) status.add("IMU samples dropped: " + reason, count);
+  status.add("scans on the LiDAR-only prior", fallbacks);
+  for (const auto& [reason, count] : core_.fallbacks) status.add("scans on the LiDAR-only prior: " + reason, count);
+  status.add("gyro bias (deg/s)", degreesPerSecond(core_.gyro_bias));
+
+  reported_fallbacks_ = fallbacks;
+  reported_dropped_ = dropped;
   window_ = Window();
 }
 

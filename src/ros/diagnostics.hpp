@@ -1,5 +1,5 @@
-// What the node has done with the clouds it received, for diagnostic_updater: totals since the start,
-// and rates and timings over the window since the previous report.
+// What the node has done with the clouds it received and, with an IMU, with its messages, for
+// diagnostic_updater: totals since the start, and rates and timings over the window since the previous report.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
@@ -9,6 +9,7 @@
 #include <mutex>
 #include <string>
 
+#include "elo/imu/imu_track.hpp"
 #include "elo/pipeline/odometry.hpp"
 
 namespace elo_ros {
@@ -82,6 +83,43 @@ class PipelineStatistics {
   size_t sensor_misfits_ = 0;                     // scans with an elo::FrameResult::sensor_warning
   std::string last_sensor_warning_;
   elo::RegistrationResult last_registration_;
+};
+
+// The IMU's state (imu.enabled, docs/imu.md), a status of its own: the Imu messages received and their
+// rate, those the node could not hand to the odometry, and the core's elo::ImuStatus (samples dropped,
+// scans fallen back to the LiDAR-only prior, the gyro's bias).
+class ImuStatistics {
+ public:
+  explicit ImuStatistics(double min_rate_hz) : min_rate_hz_(min_rate_hz) {}
+
+  // `stamp`: the message's header stamp (s).
+  void messageReceived(double stamp);
+  // A message the node did not hand to the odometry, by reason.
+  void messageUnused(const std::string& reason);
+  // After each scan: the core's state (elo::DriveSession::imuStatus()).
+  void update(const elo::ImuStatus& status);
+
+  // Fills `status` and starts a new window. WARN when the window saw no message (the IMU silent), a rate
+  // under imu.min_rate_hz (by the messages' stamps, so that a bag played slower does not warn), a message
+  // unused, a sample dropped or a scan on the LiDAR-only prior.
+  void report(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+ private:
+  struct Window {
+    size_t received = 0;
+    size_t unused = 0;
+    double first_stamp = 0.0;
+    double last_stamp = 0.0;
+  };
+
+  double min_rate_hz_;
+  std::mutex mutex_;
+  Window window_;
+  size_t received_ = 0;
+  std::map<std::string, size_t> unused_;
+  elo::ImuStatus core_;
+  size_t reported_fallbacks_ = 0;  // the core's scans fallen back and samples dropped at the last report
+  size_t reported_dropped_ = 0;
 };
 
 }  // namespace elo_ros

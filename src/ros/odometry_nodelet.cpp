@@ -47,6 +47,7 @@ void OdometryNodelet::onInit() {
     throw;
   }
   step_log_ = std::make_unique<StepLog>(getName(), config, statistics_);
+  if (config.imu.enabled) imu_ = std::make_unique<ImuInput>(getNodeHandle(), settings_, *session_, getName());
   startDiagnostics();
 
   // 0: every scan is queued (bag replay); 1: only the latest waits, older ones are dropped and counted.
@@ -80,6 +81,7 @@ void OdometryNodelet::startDiagnostics() {
   diagnostics_->setHardwareID(session_->config().sensor.name);
   diagnostics_->add("odometry", &statistics_, &PipelineStatistics::report);
   if (localization_) diagnostics_->add("localization", localization_.get(), &LocalizationFace::report);
+  if (imu_) diagnostics_->add("imu", &imu_->statistics(), &ImuStatistics::report);
   // A wall timer: diagnostics must keep coming while a replayed clock is paused or not yet started.
   diagnostics_timer_ = getNodeHandle().createWallTimer(ros::WallDuration(1.0),
                                                        [this](const ros::WallTimerEvent&) { diagnostics_->force_update(); });
@@ -94,6 +96,8 @@ OdometryNodelet::~OdometryNodelet() {
   queue_->close();
   worker_.join();
   if (settings_.save_trajectory_on_shutdown) services_->saveTrajectoryOnShutdown();
+  diagnostics_.reset();  // it reports on imu_
+  imu_.reset();          // its callbacks hand samples to the session
   session_.reset();  // its map's thread publishes through members destroyed before it
 }
 
@@ -163,12 +167,14 @@ void OdometryNodelet::processCloud(const QueuedCloud& queued) {
   header.stamp = message.header.stamp;
   header.frame_id = frames_->sensor_frame;
   std::optional<ScanPublisher::Messages> messages;
+  if (imu_) imu_->beforeScan(frames_->sensor_frame, converted.cloud.stamp);
   const elo::DriveStep step =
       session_->process(converted.cloud, [&](const elo::DriveStep& step, elo::Odometry& odometry) {
         if (step.restarted) publisher_->restart();
         if (step.odometry.processed) messages = publisher_->build(step, odometry, *frames_, header);
       });
   step_log_->log(step);
+  if (imu_) imu_->afterScan();
   if (!step.odometry.processed) return;
   std::optional<LocalizationFace::Messages> localized;
   if (localization_) localized = localization_->update(step, *frames_, header.stamp);

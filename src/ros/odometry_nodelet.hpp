@@ -1,4 +1,4 @@
-// elo_odometry/OdometryNodelet: PointCloud2 in; odometry, TF, path, the fused models, the drive's map and,
+// elo_odometry/OdometryNodelet: PointCloud2 (and, with imu.enabled, sensor_msgs/Imu) in; odometry, TF, path, the fused models, the drive's map and,
 // with a saved map, the localization out. A shell over elo::DriveSession (docs/architecture.md): it
 // converts messages, binds frames and publishes; the core does the rest.
 #pragma once
@@ -15,6 +15,7 @@
 
 #include "diagnostics.hpp"
 #include "elo/drive_session.hpp"
+#include "imu_input.hpp"
 #include "localization_face.hpp"
 #include "messages.hpp"
 #include "node_services.hpp"
@@ -60,6 +61,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::unique_ptr<ScanPublisher> publisher_;
   std::unique_ptr<StepLog> step_log_;
   std::unique_ptr<NodeServices> services_;
+  std::unique_ptr<ImuInput> imu_;  // with imu.enabled
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -188,6 +188,8 @@ NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {
   read("map_publish_period", settings.map_publish_period);
   read("map_publish_points", settings.map_publish_points);
   read("save_trajectory_on_shutdown", settings.save_trajectory_on_shutdown);
+  read("imu_mount_from_tf", settings.imu_mount_from_tf);
+  read("imu_max_wait", settings.imu_max_wait);
   settings.outputs = readOutputFiles(private_node);
   if (settings.odom_frame.empty()) throw std::invalid_argument("~odom_frame must not be empty");
   if (settings.base_frame.empty()) throw std::invalid_argument("~base_frame must not be empty");
@@ -196,6 +198,7 @@ NodeSettings readNodeSettings(const ros::NodeHandle& private_node) {
   if (settings.map_publish_period < 0.0) throw std::invalid_argument("~map_publish_period must not be negative");
   if (settings.map_publish_points < 1) throw std::invalid_argument("~map_publish_points must be positive");
   if (settings.tf_timeout < 0.0) throw std::invalid_argument("~tf_timeout must not be negative");
+  if (settings.imu_max_wait < 0.0) throw std::invalid_argument("~imu_max_wait must not be negative");
   parseTrajectoryFormat(settings.outputs.trajectory_format);
   return settings;
 }

@@ -58,6 +58,10 @@ struct NodeSettings {
   double map_publish_period = 5.0;  // s of scan time between `map` messages; 0: never
   int map_publish_points = 500000;  // at most this many voxels in a `map` message (thinned evenly)
   double tf_timeout = 1.0;          // s to wait for the sensor -> base extrinsic on a scan
+  // With imu.enabled: the IMU's mount from TF (the Imu messages' frame in the clouds' frame) instead of
+  // imu.position and imu.rotation_deg; and how long (s, wall) a scan waits for the IMU samples over its sweep.
+  bool imu_mount_from_tf = false;
+  double imu_max_wait = 0.05;
   OutputFiles outputs;
   bool save_trajectory_on_shutdown = false;  // write the trajectory file when the node stops (bag replay)
 };

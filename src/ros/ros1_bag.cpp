@@ -1,13 +1,17 @@
 #include "ros1_bag.hpp"
 
 #include <ros/message_traits.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 
 #include <algorithm>
+#include <iterator>
 #include <map>
+#include <optional>
 
 #include "cloud_conversion.hpp"
+#include "imu_conversion.hpp"
 
 // The header of a sensor_msgs/PointCloud2 alone. It is the message's first field, so deserializing just it
 // from a bag reads a few bytes of each cloud rather than copying megabytes of points: listing a bag's
@@ -52,6 +56,7 @@ namespace elo_ros {
 namespace {
 
 using CloudType = ros::message_traits::DataType<sensor_msgs::PointCloud2>;
+using ImuType = ros::message_traits::DataType<sensor_msgs::Imu>;
 
 std::vector<elo::BagTopic> topicsOf(const rosbag::Bag& bag) {
   std::map<std::string, elo::BagTopic> topics;
@@ -64,15 +69,71 @@ std::vector<elo::BagTopic> topicsOf(const rosbag::Bag& bag) {
   return list;
 }
 
-}  // namespace
-
-Ros1Bag::Ros1Bag(const std::string& path, const std::string& topic) : path_(path) {
+void openBag(rosbag::Bag& bag, const std::string& path) {
   try {
-    bag_.open(path_, rosbag::bagmode::Read);
+    bag.open(path, rosbag::bagmode::Read);
   } catch (const rosbag::BagException& error) {
-    throw elo::IoError("cannot read bag '" + path_ + "': " + error.what() +
+    throw elo::IoError("cannot read bag '" + path + "': " + error.what() +
                        " (a bag cut short has lost its index: `rosbag reindex` restores what it holds)");
   }
+}
+
+std::string listed(const std::vector<elo::BagTopic>& topics) {
+  std::string text;
+  for (const elo::BagTopic& topic : topics) text += (text.empty() ? "" : ", ") + topic.name + " (" + topic.type + ")";
+  return text;
+}
+
+// `requested` when it is an Imu topic of the bag, else its only one; empty when it has none.
+std::string chooseImuTopic(const std::string& path, const std::vector<elo::BagTopic>& topics,
+                           const std::string& requested) {
+  std::vector<elo::BagTopic> imus;
+  std::copy_if(topics.begin(), topics.end(), std::back_inserter(imus),
+               [](const elo::BagTopic& topic) { return topic.type == ImuType::value(); });
+  if (!requested.empty()) {
+    if (std::none_of(imus.begin(), imus.end(), [&](const elo::BagTopic& t) { return t.name == requested; })) {
+      throw elo::IoError("bag '" + path + "' has no " + ImuType::value() + " topic " + requested + "; its topics: " +
+                         listed(topics));
+    }
+    return requested;
+  }
+  if (imus.size() > 1) {
+    throw elo::IoError("bag '" + path + "' has several " + ImuType::value() + " topics: " + listed(imus) +
+                       "; choose one with --imu-topic");
+  }
+  return imus.empty() ? "" : imus.front().name;
+}
+
+}  // namespace
+
+BagImu readRos1BagImu(const std::string& path, const std::string& topic) {
+  rosbag::Bag bag;
+  openBag(bag, path);
+  BagImu imu;
+  imu.topic = chooseImuTopic(path, topicsOf(bag), topic);
+  if (imu.topic.empty()) return imu;
+  for (const rosbag::MessageInstance& instance : rosbag::View(bag, rosbag::TopicQuery(imu.topic))) {
+    std::string problem;
+    std::optional<elo::ImuSample> sample;
+    try {
+      if (const auto message = instance.instantiate<sensor_msgs::Imu>()) sample = imuSampleOf(*message, problem);
+    } catch (const std::exception&) {
+      // A message cut short or of another layout: counted, as a cloud that cannot be read is skipped.
+    }
+    if (sample) {
+      imu.samples.push_back(*sample);
+    } else {
+      ++imu.skipped[problem.empty() ? imu_message::kUnreadable : problem];
+    }
+  }
+  // A bag records messages as they arrived; the samples go to the odometry in the order of their stamps.
+  std::stable_sort(imu.samples.begin(), imu.samples.end(),
+                   [](const elo::ImuSample& a, const elo::ImuSample& b) { return a.stamp < b.stamp; });
+  return imu;
+}
+
+Ros1Bag::Ros1Bag(const std::string& path, const std::string& topic) : path_(path) {
+  openBag(bag_, path_);
   topic_ = elo::chooseCloudTopic("bag '" + path_ + "'", topicsOf(bag_), CloudType::value(), topic);
   listMessages();
   if (messages_.empty()) throw elo::IoError(describe() + " holds no message");

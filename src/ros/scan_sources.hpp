@@ -2,9 +2,12 @@
 // or one of its .db3 files), or a sequence directory. Here, beside the ROS 1 reader, because only the ROS layer may read ROS 1 bags.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "elo/imu/imu_track.hpp"
 #include "elo/io/scan_source.hpp"
 
 namespace elo_ros {
@@ -13,5 +16,19 @@ namespace elo_ros {
 // none, and naming one is an error. An .mcap file is refused with the command that converts it. Throws
 // elo::IoError.
 std::unique_ptr<elo::ScanSource> openScanSource(const std::string& input, const std::string& topic);
+
+// The IMU samples of elo_run's input (imu.enabled, docs/imu.md), in stamp order.
+struct ImuRecording {
+  std::vector<elo::ImuSample> samples;
+  std::string describe;                   // where they came from; empty when the input has none
+  std::map<std::string, size_t> skipped;  // messages that gave no sample, by reason
+  std::string warning;                    // why there are none: the odometry runs on the LiDAR alone
+};
+
+// From a ROS 1 bag, its sensor_msgs/Imu topic `imu_topic` (empty: its only one; none: a warning); from a
+// directory, its imu.txt. Throws elo::IoError for a directory without imu.txt or with a malformed one, an
+// `imu_topic` with an input that is no ROS 1 bag, or a bag's Imu topics that readRos1BagImu() refuses. A
+// ROS 2 bag's IMU is not read: a warning.
+ImuRecording readImuRecording(const std::string& input, const std::string& imu_topic);
 
 }  // namespace elo_ros

@@ -5,6 +5,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "cloud_conversion.hpp"
+#include "imu_conversion.hpp"
 
 namespace elo_ros {
 
@@ -22,10 +23,27 @@ void SequenceBagWriter::write(const elo::PointCloud& cloud, const Eigen::Isometr
 ros::Time SequenceBagWriter::writeCloud(const elo::PointCloud& cloud) {
   sensor_msgs::PointCloud2 message = toPointCloud2(cloud, options_.frame);
   message.header.stamp = ros::Time(cloud.stamp + options_.start_time);
-  bag_.write(options_.topic, message.header.stamp, message);
+  bag_.write(options_.topic, message.header.stamp + ros::Duration(options_.cloud_record_delay), message);
   ++scans_;
   points_ += cloud.size();
   return message.header.stamp;
+}
+
+void SequenceBagWriter::write(const elo::ImuSample& sample) {
+  elo::ImuSample shifted = sample;
+  shifted.stamp += options_.start_time;
+  const sensor_msgs::Imu message = imuMessageOf(shifted, options_.imu_frame);
+  bag_.write(options_.imu_topic, message.header.stamp, message);
+}
+
+void SequenceBagWriter::writeImuMount(const Eigen::Isometry3d& lidar_from_imu, double stamp) {
+  geometry_msgs::TransformStamped transform = tf2::eigenToTransform(lidar_from_imu);
+  transform.header.stamp = ros::Time(stamp + options_.start_time);
+  transform.header.frame_id = options_.frame;
+  transform.child_frame_id = options_.imu_frame;
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(transform);
+  bag_.write("/tf_static", transform.header.stamp, tf);
 }
 
 void SequenceBagWriter::writeGroundTruth(const ros::Time& stamp, const Eigen::Isometry3d& pose) {

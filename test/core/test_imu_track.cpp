@@ -144,5 +144,22 @@ TEST(ImuTrack, OnlyTheSamplesAnIntervalStillNeedsAreKept) {
   EXPECT_EQ(track.rotation(0.49, 0.9, rotation), imu_issue::kNotCovered);
 }
 
+// The ROS node learns the mount from TF once running: the samples it already holds are read through the
+// mount set then. Only the samples taken are counted; the bias estimate is the configured one and the learnt.
+TEST(ImuTrack, AMountSetLaterTurnsTheSamplesHeldThroughIt) {
+  ImuConfig config;
+  config.gyro_bias = {0.001, 0.0, 0.0};
+  ImuTrack track(config);
+  feed(track, 0.0, 1.0, [](double) { return Eigen::Vector3d(0.001, 0.0, 1.0); });
+  ImuSample not_finite = sampleAt(1.5, Eigen::Vector3d(0.0, 0.0, std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_EQ(track.add(not_finite), imu_issue::kNotFinite);
+  EXPECT_EQ(track.takenCount(), 201u);
+  track.setMount(mountedUpsideDownAndTurned());
+  Eigen::Matrix3d rotation;
+  ASSERT_EQ(track.rotation(0.2, 0.7, rotation), "");
+  EXPECT_LT(angleBetween(rotation, Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix()), 1e-12);
+  EXPECT_EQ(track.biasEstimate(), Eigen::Vector3d(0.001, 0.0, 0.0));
+}
+
 }  // namespace
 }  // namespace elo

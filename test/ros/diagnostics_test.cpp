@@ -136,3 +136,62 @@ TEST(RosDiagnostics, DegenerateScansWarnWhileTheyLastAndAreCounted) {
 }
 
 }  // namespace
+
+namespace {
+
+// `count` Imu messages `period` seconds apart from `start`, then the window's status.
+diagnostic_updater::DiagnosticStatusWrapper imuStatusAfter(elo_ros::ImuStatistics& statistics, int count,
+                                                           double period, double start = 0.0) {
+  for (int i = 0; i < count; ++i) statistics.messageReceived(start + i * period);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  statistics.report(status);
+  return status;
+}
+
+}  // namespace
+
+// The IMU's status: OK at its rate; WARN while it is silent, under imu.min_rate_hz (by the stamps), or in
+// a window where scans fell back, samples were dropped or messages unused, each counted by reason.
+TEST(RosDiagnostics, ImuAtItsRateIsOkAndSilenceSlownessAndFallbacksWarn) {
+  elo_ros::ImuStatistics statistics(50.0);
+  elo::ImuStatus core;
+  core.enabled = true;
+  core.samples_taken = 200;
+  core.gyro_bias = {M_PI / 180.0, 0.0, -0.5 * M_PI / 180.0};
+  statistics.update(core);
+  const diagnostic_updater::DiagnosticStatusWrapper steady = imuStatusAfter(statistics, 201, 0.005);
+  EXPECT_EQ(steady.level, diagnostic_msgs::DiagnosticStatus::OK) << steady.message;
+  EXPECT_EQ(valueOf(steady, "IMU rate (Hz)"), "200");
+  EXPECT_EQ(valueOf(steady, "Imu messages received"), "201");
+  EXPECT_EQ(valueOf(steady, "IMU samples taken"), "200");
+  EXPECT_EQ(valueOf(steady, "gyro bias (deg/s)"), "1, 0, -0.5");
+  EXPECT_EQ(valueOf(steady, "scans on the LiDAR-only prior"), "0");
+
+  const diagnostic_updater::DiagnosticStatusWrapper silent = imuStatusAfter(statistics, 0, 0.005);
+  EXPECT_EQ(silent.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(silent.message.find("IMU silent"), std::string::npos) << silent.message;
+
+  // A bag played at half speed: 100 messages a second of wall time, 200 Hz by their stamps.
+  EXPECT_EQ(imuStatusAfter(statistics, 101, 0.005, 2.0).level, diagnostic_msgs::DiagnosticStatus::OK);
+  const diagnostic_updater::DiagnosticStatusWrapper slow = imuStatusAfter(statistics, 21, 0.05, 3.0);
+  EXPECT_EQ(slow.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(slow.message.find("IMU rate 20 Hz under imu.min_rate_hz (50)"), std::string::npos) << slow.message;
+
+  core.fallbacks[elo::imu_issue::kGap] = 2;
+  core.dropped[elo::imu_issue::kNotFinite] = 1;
+  statistics.update(core);
+  statistics.messageUnused("no IMU -> LiDAR transform from TF");
+  const diagnostic_updater::DiagnosticStatusWrapper faults = imuStatusAfter(statistics, 201, 0.005, 5.0);
+  EXPECT_EQ(faults.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(faults.message.find("1 Imu messages unused, 1 IMU samples dropped, 2 scans on the LiDAR-only prior"),
+            std::string::npos)
+      << faults.message;
+  EXPECT_EQ(valueOf(faults, std::string("scans on the LiDAR-only prior: ") + elo::imu_issue::kGap), "2");
+  EXPECT_EQ(valueOf(faults, std::string("IMU samples dropped: ") + elo::imu_issue::kNotFinite), "1");
+  EXPECT_EQ(valueOf(faults, "Imu messages unused: no IMU -> LiDAR transform from TF"), "1");
+  EXPECT_EQ(valueOf(faults, "scans on the LiDAR-only prior"), "2");
+  // The counts stay; a window without new ones is OK again.
+  const diagnostic_updater::DiagnosticStatusWrapper again = imuStatusAfter(statistics, 201, 0.005, 7.0);
+  EXPECT_EQ(again.level, diagnostic_msgs::DiagnosticStatus::OK) << again.message;
+  EXPECT_EQ(valueOf(again, "scans on the LiDAR-only prior"), "2");
+}

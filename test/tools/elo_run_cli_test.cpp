@@ -3,25 +3,68 @@
 // --strict stops at such a scan with a non-zero exit, after writing the poses of the scans before it.
 // --no-prefetch changes no pose. The same drive as a ROS 1 bag (kitti_to_bag) and a ROS 2 bag (our test
 // writer) gives the directory's poses bit for bit; malformed, truncated and empty bags are clear errors or
-// counted skips that keep the poses computed so far. --start plays from a later scan.
+// counted skips that keep the poses computed so far. --start plays from a later scan. The IMU from a bag's
+// sensor_msgs/Imu topic (--imu-topic) gives the poses of the same drive's imu.txt.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <rosbag/bag.h>
+#include <sensor_msgs/Imu.h>
 
 #include "../io/ros2_bag_writer.hpp"
 #include "../io/temp_directory.hpp"
 #include "cloud_conversion.hpp"
+#include "imu_conversion.hpp"
 #include "run_command.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/pcd.hpp"
 #include "elo/io/sequence.hpp"
+
+// An Imu message cut short after its header, as a broken driver or recorder could leave it: rosbag records
+// it as a sensor_msgs/Imu.
+namespace imu_test {
+struct TruncatedImu {
+  std_msgs::Header header;
+};
+}  // namespace imu_test
+
+namespace ros {
+namespace message_traits {
+template <>
+struct MD5Sum<imu_test::TruncatedImu> {
+  static const char* value() { return MD5Sum<sensor_msgs::Imu>::value(); }
+  static const char* value(const imu_test::TruncatedImu&) { return value(); }
+};
+template <>
+struct DataType<imu_test::TruncatedImu> {
+  static const char* value() { return DataType<sensor_msgs::Imu>::value(); }
+  static const char* value(const imu_test::TruncatedImu&) { return value(); }
+};
+template <>
+struct Definition<imu_test::TruncatedImu> {
+  static const char* value() { return Definition<sensor_msgs::Imu>::value(); }
+  static const char* value(const imu_test::TruncatedImu&) { return value(); }
+};
+}  // namespace message_traits
+
+namespace serialization {
+template <>
+struct Serializer<imu_test::TruncatedImu> {
+  template <typename Stream, typename T>
+  inline static void allInOne(Stream& stream, T message) {
+    stream.next(message.header);
+  }
+  ROS_DECLARE_ALLINONE_SERIALIZER
+};
+}  // namespace serialization
+}  // namespace ros
 
 namespace {
 
@@ -443,4 +486,111 @@ TEST_F(EloRunCli, ImuTxtBesideTheScansTurnsEveryScan) {
   const CommandResult without_file = runEloRunOn(drive, poses(), "--config " + drive + "/imu.yaml");
   EXPECT_NE(without_file.exit_code, 0);
   EXPECT_TRUE(contains(without_file.output, "imu.txt")) << without_file.output;
+}
+
+namespace {
+
+// The largest difference between two KITTI pose files' numbers; infinity when their lines differ in count.
+double largestDifference(const std::string& a, const std::string& b) {
+  const std::vector<Eigen::Isometry3d> first = elo::readKittiPoses(a);
+  const std::vector<Eigen::Isometry3d> second = elo::readKittiPoses(b);
+  if (first.size() != second.size()) return std::numeric_limits<double>::infinity();
+  double largest = 0.0;
+  for (size_t i = 0; i < first.size(); ++i) {
+    largest = std::max(largest, (first[i].matrix() - second[i].matrix()).cwiseAbs().maxCoeff());
+  }
+  return largest;
+}
+
+}  // namespace
+
+// elo_sim --imu --bag writes the IMU twice: imu.txt beside the scans, sensor_msgs/Imu on the bag's /imu
+// (stamped as its clouds, a second later). elo_run takes the bag's only Imu topic and gives the poses of
+// the directory with its imu.txt, within the rounding of the bag's nanosecond stamps.
+TEST_F(EloRunCli, ImuTopicOfABagGivesThePosesOfTheSameDrivesImuTxt) {
+  const std::string drive = directory_.file("imu_drive");
+  const std::string bag = directory_.file("imu_drive.bag");
+  const CommandResult simulated = runCommand(std::string(ELO_SIM_TOOL) +
+                                             " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 "
+                                             "--threads 2 --format pcd --imu consumer --output " + drive + " --bag " + bag);
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  const std::string imu_yaml = "--config " + drive + "/imu.yaml";
+  const CommandResult from_file = runEloRunOn(drive, directory_.file("from_file.txt"), imu_yaml);
+  ASSERT_EQ(from_file.exit_code, 0) << from_file.output;
+  EXPECT_TRUE(contains(from_file.output, "every scan turned by the IMU")) << from_file.output;
+  const CommandResult from_bag = runEloRunOn(bag, directory_.file("from_bag.txt"), imu_yaml);
+  ASSERT_EQ(from_bag.exit_code, 0) << from_bag.output;
+  EXPECT_TRUE(contains(from_bag.output, "imu: bag '" + bag + "', topic /imu")) << from_bag.output;
+  EXPECT_TRUE(contains(from_bag.output, "every scan turned by the IMU")) << from_bag.output;
+  EXPECT_LT(largestDifference(directory_.file("from_file.txt"), directory_.file("from_bag.txt")), 1e-6);
+  // Not the poses of the LiDAR alone: the gyro did turn these scans.
+  const CommandResult lidar_only = runEloRunOn(bag, directory_.file("lidar_only.txt"));
+  ASSERT_EQ(lidar_only.exit_code, 0) << lidar_only.output;
+  EXPECT_GT(largestDifference(directory_.file("from_bag.txt"), directory_.file("lidar_only.txt")), 1e-6);
+}
+
+// The suite's straight drive as a bag with two IMUs that do not turn (as the drive does not): named, one
+// of them turns every scan, its truncated message skipped and counted; unnamed, the run stops naming both.
+TEST_F(EloRunCli, BagWithTwoImuTopicsNeedsImuTopicAndSkipsAMalformedMessage) {
+  const std::string bag = directory_.file("two_imus.bag");
+  {
+    const elo::Sequence sequence(sequence_.string());
+    rosbag::Bag writer(bag, rosbag::bagmode::Write);
+    for (size_t i = 0; i < sequence.size(); ++i) {
+      elo::PointCloud cloud = sequence.load(i);
+      cloud.stamp += kBagStartTime;
+      const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      writer.write("/points", message.header.stamp, message);
+    }
+    const double end = sequence.stamp(sequence.size() - 1) + kBagStartTime + 0.2;
+    for (int k = 0; kBagStartTime - 0.1 + k * 0.005 <= end; ++k) {
+      elo::ImuSample sample;
+      sample.stamp = kBagStartTime - 0.1 + k * 0.005;
+      sample.specific_force = {0.0, 0.0, 9.81};
+      const sensor_msgs::Imu message = elo_ros::imuMessageOf(sample, "imu");
+      if (k == 20) {
+        writer.write("/imu/a", message.header.stamp, imu_test::TruncatedImu{message.header});
+      } else {
+        writer.write("/imu/a", message.header.stamp, message);
+      }
+      writer.write("/imu/b", message.header.stamp, message);
+    }
+  }
+  const CommandResult ambiguous = runEloRunOn(bag, poses(), "--set imu.enabled=true");
+  EXPECT_EQ(ambiguous.exit_code, 1) << ambiguous.output;
+  EXPECT_TRUE(contains(ambiguous.output,
+                       "several sensor_msgs/Imu topics: /imu/a (sensor_msgs/Imu), /imu/b (sensor_msgs/Imu)"))
+      << ambiguous.output;
+  EXPECT_TRUE(contains(ambiguous.output, "--imu-topic")) << ambiguous.output;
+
+  const CommandResult chosen = runEloRunOn(bag, poses(), "--set imu.enabled=true --imu-topic /imu/a");
+  ASSERT_EQ(chosen.exit_code, 0) << chosen.output;
+  EXPECT_TRUE(contains(chosen.output, "warning: 1 IMU message skipped: Imu message unreadable")) << chosen.output;
+  EXPECT_TRUE(contains(chosen.output, "IMU: 1 message skipped (Imu message unreadable)")) << chosen.output;
+  EXPECT_TRUE(contains(chosen.output, "every scan turned by the IMU")) << chosen.output;
+  EXPECT_EQ(lines(poses()).size(), kScans);
+
+  const CommandResult missing = runEloRunOn(bag, poses(), "--set imu.enabled=true --imu-topic /imu/c");
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_TRUE(contains(missing.output, "has no sensor_msgs/Imu topic /imu/c")) << missing.output;
+}
+
+// No Imu topic in the bag: a warning, and the LiDAR alone for every scan, each counted. --imu-topic needs
+// imu.enabled, and a bag to name a topic of.
+TEST_F(EloRunCli, BagWithoutImuTopicRunsOnTheLidarAlone) {
+  const std::string bag = directory_.file("drive.bag");
+  ASSERT_EQ(writeRos1Bag(sequence_.string(), bag).exit_code, 0);
+  const CommandResult result = runEloRunOn(bag, poses(), "--set imu.enabled=true");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "has no sensor_msgs/Imu topic: the LiDAR alone")) << result.output;
+  EXPECT_TRUE(contains(result.output, std::to_string(kScans) + " on the LiDAR-only prior (no IMU samples over the scan)"))
+      << result.output;
+  EXPECT_EQ(lines(poses()).size(), kScans);
+
+  const CommandResult not_enabled = runEloRunOn(bag, poses(), "--imu-topic /imu");
+  EXPECT_EQ(not_enabled.exit_code, 2) << not_enabled.output;
+  EXPECT_TRUE(contains(not_enabled.output, "--imu-topic needs imu.enabled")) << not_enabled.output;
+  const CommandResult directory = runEloRun("--set imu.enabled=true --imu-topic /imu");
+  EXPECT_EQ(directory.exit_code, 1) << directory.output;
+  EXPECT_TRUE(contains(directory.output, "is not one")) << directory.output;
 }

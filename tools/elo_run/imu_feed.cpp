@@ -1,26 +1,33 @@
 #include "imu_feed.hpp"
 
-#include <filesystem>
+#include <cstdio>
 
-#include "elo/io/imu_file.hpp"
-#include "elo/io/io_error.hpp"
+#include "command_line.hpp"
+#include "scan_sources.hpp"
 
 namespace elo::tools {
 
-ImuFeed::ImuFeed(const std::string& input, const Config& config)
+ImuFeed::ImuFeed(const Options& options, const Config& config)
     : sweep_(1.0 / config.sensor.rotation_rate_hz), time_offset_(config.imu.time_offset) {
-  if (!config.imu.enabled) return;
-  const std::filesystem::path file = std::filesystem::path(input) / "imu.txt";
-  if (!std::filesystem::is_regular_file(file)) {
-    throw IoError("imu.enabled, but " + file.string() +
-                  " is not there: elo_run reads the IMU from the imu.txt of a KITTI-layout directory (docs/imu.md)");
+  if (!config.imu.enabled) {
+    if (!options.imu_topic.empty()) throw UsageError("--imu-topic needs imu.enabled (--set imu.enabled=true)");
+    return;
   }
-  samples_ = readImuFile(file.string());
+  elo_ros::ImuRecording recording = elo_ros::readImuRecording(options.input, options.imu_topic);
+  if (!recording.warning.empty()) std::fprintf(stderr, "warning: %s\n", recording.warning.c_str());
+  if (!recording.describe.empty()) std::printf("imu: %s, %zu samples\n", recording.describe.c_str(), recording.samples.size());
+  for (const auto& [reason, count] : recording.skipped) {
+    std::fprintf(stderr, "warning: %zu IMU message%s skipped: %s\n", count, count > 1 ? "s" : "", reason.c_str());
+  }
+  samples_ = std::move(recording.samples);
+  skipped_ = std::move(recording.skipped);
 }
 
 void ImuFeed::feedUpTo(double stamp, DriveSession& session) {
-  // A sweep after the stamp covers the sweep of a scan stamped at its start (`field` times), and more.
-  for (; next_ < samples_.size() && samples_[next_].stamp + time_offset_ <= stamp + sweep_; ++next_) {
+  // The sweep of a scan stamped at its start (`field` times) ends a sweep after the stamp, where a sample
+  // must lie at or after it: half a sweep more takes that sample whatever the stamps' rounding (a sample
+  // stamped at the sweep's end on another clock, a bag's nanoseconds). Samples ahead do no harm.
+  for (; next_ < samples_.size() && samples_[next_].stamp + time_offset_ <= stamp + 1.5 * sweep_; ++next_) {
     session.addImu(samples_[next_]);
   }
 }

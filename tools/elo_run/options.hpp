@@ -17,6 +17,7 @@ extern const char kEloRunUsage[];
 struct Options {
   std::string input;
   std::string topic;
+  std::string imu_topic;  // --imu-topic
   std::string output;
   std::vector<std::string> config_files;  // applied in order
   std::string timing_csv;

@@ -43,7 +43,7 @@ ScanLoop::ScanLoop(const Options& options, const ScanSource& source, DriveSessio
     : options_(options),
       source_(source),
       session_(session),
-      imu_(options.input, session.config()),
+      imu_(options, session.config()),
       report_(options.prefetch) {
   if (session.localizer() != nullptr) localization_report_.emplace(session.localizer()->state());
   if (options.timing_csv.empty()) return;

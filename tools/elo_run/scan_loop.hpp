@@ -27,7 +27,7 @@ struct ScanRead {
 
 class ScanLoop {
  public:
-  // Throws IoError when --timing's file cannot be written, or imu.enabled has no imu.txt to read.
+  // Throws IoError when --timing's file cannot be written, or the IMU cannot be read (ImuFeed).
   ScanLoop(const Options& options, const ScanSource& source, DriveSession& session);
 
   // Reads and processes every played scan. A scan that cannot be read is skipped (its line repeats the
@@ -41,6 +41,7 @@ class ScanLoop {
   const RunReport& report() const { return report_; }
   const std::optional<LocalizationReport>& localizationReport() const { return localization_report_; }
   size_t nonFinitePoints() const { return non_finite_points_; }
+  const ImuFeed& imu() const { return imu_; }
 
  private:
   // Reads the scan, stamped as played, and prefetches it unless --no-prefetch.

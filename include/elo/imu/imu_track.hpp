@@ -33,6 +33,15 @@ inline constexpr char kGap[] = "IMU gap over the scan (imu.min_rate_hz)";
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
 // instants) and its mean rate over the scan's sweep, in the LiDAR's frame. Known when the samples cover
 // both; else `fallback` says why (empty without imu.enabled).
+// The IMU's state for a report (the node's diagnostics, elo_run's summary): Odometry::imuStatus().
+struct ImuStatus {
+  bool enabled = false;                      // imu.enabled
+  size_t samples_taken = 0;                  // since the start, those dropped not counted
+  std::map<std::string, size_t> dropped;     // samples, by imu_issue
+  std::map<std::string, size_t> fallbacks;   // scans the gyro could not turn, by imu_issue
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // rad/s, the IMU's axes: imu.gyro_bias and the bias learnt
+};
+
 struct GyroMotion {
   bool known = false;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -43,6 +52,10 @@ struct GyroMotion {
 class ImuTrack {
  public:
   explicit ImuTrack(const ImuConfig& config);
+
+  // Takes the mount of `config` (imu.position, imu.rotation_deg) in place of the one it was built with: a
+  // mount known only once running (the ROS node's, from TF). The samples held are read through it from now on.
+  void setMount(const ImuConfig& config);
 
   // Takes a sample; returns empty, or why it was dropped (counted in droppedCounts()). A sample over a
   // second before the last one (a bag played again) restarts the track from it, counted as kClockJump.
@@ -64,6 +77,10 @@ class ImuTrack {
 
   const std::map<std::string, size_t>& droppedCounts() const { return dropped_; }
   size_t size() const { return samples_.size(); }
+  // Samples taken since the start (dropped ones not counted), and the gyro's whole bias estimate
+  // (imu.gyro_bias and learntBias(), rad/s, the IMU's axes).
+  size_t takenCount() const { return taken_; }
+  Eigen::Vector3d biasEstimate() const { return gyro_bias_ + learnt_bias_; }
 
  private:
   double max_gap_;
@@ -74,6 +91,7 @@ class ImuTrack {
   double bias_time_constant_;
   Eigen::Vector3d learnt_bias_ = Eigen::Vector3d::Zero();
   size_t bias_updates_ = 0;
+  size_t taken_ = 0;
   std::deque<ImuSample> samples_;  // the scans' clock, bias removed, in time order
   std::map<std::string, size_t> dropped_;
 };

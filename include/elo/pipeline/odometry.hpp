@@ -89,6 +89,10 @@ class Odometry {
   // the motion prior and the deskew of the scans whose sweeps and intervals its samples cover. A sample
   // that is not finite, saturated or out of order is dropped and counted (imuDroppedCounts()).
   void addImu(const ImuSample& sample) { imu_.add(sample); }
+  // The IMU's mount in the LiDAR frame, as imu.position (m) and imu.rotation_deg (roll, pitch, yaw) give
+  // it, in place of the configuration's: for a mount known only once running (the ROS node's, from TF).
+  // config() says it from then on.
+  void setImuMount(const std::vector<double>& position, const std::vector<double>& rotation_deg);
   // Hands over the scan a later process() call will be given, normally the call after the next one, so
   // that a device backend uploads it while the next call processes its scan (Backend::prefetch(),
   // docs/cuda.md). Only a speed-up: process() gives the same results, bit for bit, whatever was
@@ -135,6 +139,8 @@ class Odometry {
   // dropped, by reason.
   const std::map<std::string, size_t>& imuFallbackCounts() const { return imu_fallbacks_; }
   const std::map<std::string, size_t>& imuDroppedCounts() const { return imu_.droppedCounts(); }
+  // The IMU's state in one struct, for the node's diagnostics.
+  ImuStatus imuStatus() const;
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over

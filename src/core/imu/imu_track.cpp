@@ -43,6 +43,8 @@ ImuTrack::ImuTrack(const ImuConfig& config)
       lidar_from_imu_(config.rotation_deg.size() == 3 ? lidarFromImuRotation(config) : Eigen::Matrix3d::Identity()),
       bias_time_constant_(config.bias_time_constant) {}
 
+void ImuTrack::setMount(const ImuConfig& config) { lidar_from_imu_ = lidarFromImuRotation(config); }
+
 std::string ImuTrack::add(const ImuSample& sample) {
   std::string issue;
   if (!finite(sample)) {
@@ -67,6 +69,7 @@ std::string ImuTrack::add(const ImuSample& sample) {
   taken.stamp += time_offset_;
   taken.angular_velocity -= gyro_bias_;
   samples_.push_back(taken);
+  ++taken_;
   return {};
 }
 
