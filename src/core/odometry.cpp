@@ -1,6 +1,7 @@
 #include "elo/pipeline/odometry.hpp"
 
 #include <cmath>
+#include <utility>
 
 #include "core/elapsed_time.hpp"
 #include "elo/pipeline/deskew.hpp"
@@ -138,15 +139,16 @@ GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResu
 }
 
 void Odometry::setImuMount(const std::vector<double>& position, const std::vector<double>& rotation_deg) {
-  config_.imu.position = position;
-  config_.imu.rotation_deg = rotation_deg;
-  validate(config_);
+  Config mounted = config_;
+  mounted.imu.position = position;
+  mounted.imu.rotation_deg = rotation_deg;
+  validate(mounted);
+  config_ = std::move(mounted);
   imu_.setMount(config_.imu);
 }
 
 ImuStatus Odometry::imuStatus() const {
   ImuStatus status;
-  status.enabled = config_.imu.enabled;
   status.samples_taken = imu_.takenCount();
   status.dropped = imu_.droppedCounts();
   status.fallbacks = imu_fallbacks_;

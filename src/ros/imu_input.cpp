@@ -96,7 +96,8 @@ void ImuInput::lookUpMount(const std::string& sensor_frame) {
       return;
     }
   }
-  // R = Rz(yaw) Ry(pitch) Rx(roll): imu.rotation_deg's convention (elo::lidarFromImuRotation()).
+  // R = Rz(yaw) Ry(pitch) Rx(roll): imu.rotation_deg's convention (elo::lidarFromImuRotation()). TF holds
+  // no transform that is not finite (tf2 refuses them).
   const Eigen::Vector3d yaw_pitch_roll = lidar_from_imu.linear().eulerAngles(2, 1, 0);
   const Eigen::Vector3d& position = lidar_from_imu.translation();
   session_.setImuMount({position.x(), position.y(), position.z()},

@@ -155,7 +155,6 @@ diagnostic_updater::DiagnosticStatusWrapper imuStatusAfter(elo_ros::ImuStatistic
 TEST(RosDiagnostics, ImuAtItsRateIsOkAndSilenceSlownessAndFallbacksWarn) {
   elo_ros::ImuStatistics statistics(50.0);
   elo::ImuStatus core;
-  core.enabled = true;
   core.samples_taken = 200;
   core.gyro_bias = {M_PI / 180.0, 0.0, -0.5 * M_PI / 180.0};
   statistics.update(core);

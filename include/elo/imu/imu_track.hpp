@@ -30,18 +30,18 @@ inline constexpr char kNotCovered[] = "no IMU samples over the scan";
 inline constexpr char kGap[] = "IMU gap over the scan (imu.min_rate_hz)";
 }  // namespace imu_issue
 
-// What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
-// instants) and its mean rate over the scan's sweep, in the LiDAR's frame. Known when the samples cover
-// both; else `fallback` says why (empty without imu.enabled).
-// The IMU's state for a report (the node's diagnostics, elo_run's summary): Odometry::imuStatus().
+// The IMU's state for a report (the node's diagnostics): Odometry::imuStatus(). Open to more (the
+// accelerometers' gravity and bias).
 struct ImuStatus {
-  bool enabled = false;                      // imu.enabled
   size_t samples_taken = 0;                  // since the start, those dropped not counted
   std::map<std::string, size_t> dropped;     // samples, by imu_issue
   std::map<std::string, size_t> fallbacks;   // scans the gyro could not turn, by imu_issue
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // rad/s, the IMU's axes: imu.gyro_bias and the bias learnt
 };
 
+// What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
+// instants) and its mean rate over the scan's sweep, in the LiDAR's frame. Known when the samples cover
+// both; else `fallback` says why (empty without imu.enabled).
 struct GyroMotion {
   bool known = false;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
