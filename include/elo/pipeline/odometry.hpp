@@ -12,6 +12,7 @@
 #include "elo/config.hpp"
 #include "elo/pipeline/deskew.hpp"
 #include "elo/imu/imu_track.hpp"
+#include "elo/imu/inertial_filter.hpp"
 #include "elo/pipeline/motion_prior.hpp"
 #include "elo/pipeline/registration.hpp"
 #include "elo/sensor/sensor_height_check.hpp"
@@ -206,6 +207,15 @@ class Odometry {
   // scan, between their reference instants, and its mean rate over the sweep; a fallback is counted and
   // put in `result`. Nothing without imu.enabled.
   GyroMotion gyroMotion(double stamp, const CloudTimes& times, FrameResult& result);
+  // The IMU's motion between the last accepted scan's reference instant and this scan's (imu.accelerometer;
+  // samples covering it, as the gyro's), into inertial_interval_; whether it is known.
+  bool preintegrateInterval(double previous_reference, double reference);
+  // The accelerometers' translation for the guess, when the inertial filter is ready (its velocity known).
+  bool inertialPriorKnown() const { return inertial_interval_known_ && inertial_.ready(); }
+  // The accepted registration `reference_delta` corrects the inertial filter, which moves on to this scan
+  // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
+  // reference frame in the world.
+  void followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta);
   // `velocity` (a sweep's twist per second) turning at the gyro's rate over the scan's sweep, when known.
   Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
@@ -248,6 +258,9 @@ class Odometry {
   size_t tracking_restarts_ = 0;
   ImuTrack imu_;
   GyroMotion gyro_;  // of the scan being processed
+  InertialFilter inertial_;
+  Preintegration inertial_interval_;  // of the scan being processed, since the last accepted one
+  bool inertial_interval_known_ = false;
   std::map<std::string, size_t> imu_fallbacks_;
 };
 
