@@ -124,7 +124,7 @@ Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
     guess = result.start_search.motion;
   }
   if (gyro_.known) guess.linear() = gyro_.rotation;
-  if (motion_.known() && gyro_.known && inertialPriorKnown()) {
+  if (motion_.known() && inertialPriorKnown()) {
     guess.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
   }
   return guess;
@@ -214,7 +214,7 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
   ++refused_in_row_;
   result.delta = expSE3(held_velocity_ * dt);
   if (gyro_.known) result.delta.linear() = gyro_.rotation;
-  if (gyro_.known && inertialPriorKnown()) {
+  if (inertialPriorKnown()) {
     result.delta.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
   }
   result.pose = pose_ * result.delta;

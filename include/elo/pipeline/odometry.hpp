@@ -136,6 +136,9 @@ class Odometry {
   // dropped, by reason.
   const std::map<std::string, size_t>& imuFallbackCounts() const { return imu_fallbacks_; }
   const std::map<std::string, size_t>& imuDroppedCounts() const { return imu_.droppedCounts(); }
+  // With imu.accelerometer: gravity in the odometry's world frame (the first scan's), the IMU's velocity
+  // and the accelerometers' bias as estimated so far (InertialFilter; started() once a scan was registered).
+  const InertialFilter& inertialState() const { return inertial_; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -210,7 +213,8 @@ class Odometry {
   // The IMU's motion between the last accepted scan's reference instant and this scan's (imu.accelerometer;
   // samples covering it, as the gyro's), into inertial_interval_; whether it is known.
   bool preintegrateInterval(double previous_reference, double reference);
-  // The accelerometers' translation for the guess, when the inertial filter is ready (its velocity known).
+  // Whether the accelerometers give this scan's translation: the IMU covered its interval and the inertial
+  // filter's velocity is known.
   bool inertialPriorKnown() const { return inertial_interval_known_ && inertial_.ready(); }
   // The accepted registration `reference_delta` corrects the inertial filter, which moves on to this scan
   // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
