@@ -283,6 +283,18 @@ struct ImuConfig {
   // car's sweeps enough to cost r_rel a fifth; the registration's noise (about 0.1 deg/s a scan) averages out
   // over this time. 0 keeps imu.gyro_bias as given.
   double bias_time_constant = 10.0;
+  // Whether the accelerometers give the translation of the motion prior (docs/imu.md): the velocity
+  // registered, carried on by the integrated specific force less the bias, plus gravity. False: the
+  // translation is the LiDAR's prior (constant velocity or acceleration), the gyro still turns it.
+  bool accelerometer = true;
+  // m/s^2: a sample with a specific force at or beyond this on any axis is taken as saturated and dropped
+  // (consumer MEMS units are built for 16 g, often set to 2-8 g).
+  double accel_limit = 156.9;
+  // m/s^2, the IMU's axes: the accelerometers' bias at the start, subtracted from every sample.
+  std::vector<double> accel_bias = {0.0, 0.0, 0.0};
+  // s: the accelerometers' bias is then estimated online against the LiDAR's registered translations, as
+  // a random walk that may move by its prior (0.1 m/s^2) over about this long. 0 keeps imu.accel_bias.
+  double accel_bias_time_constant = 100.0;
 };
 
 struct Config {

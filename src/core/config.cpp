@@ -253,6 +253,14 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("imu.gyro_bias", c.imu.gyro_bias, "rad/s: the gyro's bias in the IMU's axes at the start, [x, y, z]"),
       bindField("imu.bias_time_constant", c.imu.bias_time_constant,
                 "s: the gyro's bias estimated online against the registered rotations over about this long; 0: fixed"),
+      bindField("imu.accelerometer", c.imu.accelerometer,
+                "the translation of the motion prior from the velocity and the integrated specific force"),
+      bindField("imu.accel_limit", c.imu.accel_limit,
+                "m/s^2: a specific force at or beyond this on an axis is saturated, dropped"),
+      bindField("imu.accel_bias", c.imu.accel_bias,
+                "m/s^2: the accelerometers' bias in the IMU's axes at the start, [x, y, z]"),
+      bindField("imu.accel_bias_time_constant", c.imu.accel_bias_time_constant,
+                "s: the accelerometers' bias estimated online against the registered translations; 0: fixed"),
   };
 }
 
@@ -377,6 +385,9 @@ void validate(const Config& c) {
   require(imu.min_rate_hz > 0.0, "imu.min_rate_hz", "must be positive");
   require(imu.gyro_limit_dps > 0.0, "imu.gyro_limit_dps", "must be positive");
   require(imu.bias_time_constant >= 0.0, "imu.bias_time_constant", "must not be negative");
+  require(imu.accel_limit > 0.0, "imu.accel_limit", "must be positive");
+  require(imu.accel_bias.size() == 3, "imu.accel_bias", "must list 3 numbers: x, y, z");
+  require(imu.accel_bias_time_constant >= 0.0, "imu.accel_bias_time_constant", "must not be negative");
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

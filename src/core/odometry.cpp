@@ -15,7 +15,8 @@ Odometry::Odometry(const Config& config)
       motion_(config.model.motion_prior),
       guard_(config),
       height_check_(config.ground.sensor_height),
-      imu_(config.imu) {
+      imu_(config.imu),
+      inertial_(config.imu) {
   validate(config_);
   backend_ = makeBackend(config_, &backend_warning_);
 }
@@ -31,6 +32,7 @@ void Odometry::restartModel() {
 
 void Odometry::reset() {
   restartModel();
+  inertial_.reset();
   pose_ = Eigen::Isometry3d::Identity();
   stamp_in_reference_ = Eigen::Isometry3d::Identity();
 }
@@ -123,7 +125,24 @@ Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
     guess = result.start_search.motion;
   }
   if (gyro_.known) guess.linear() = gyro_.rotation;
+  if (motion_.known() && inertialPriorKnown()) {
+    guess.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
+  }
   return guess;
+}
+
+bool Odometry::preintegrateInterval(double previous_reference, double reference) {
+  if (!config_.imu.accelerometer || !started_) return false;
+  return imu_.preintegrate(previous_reference, reference, inertial_interval_).empty();
+}
+
+void Odometry::followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta) {
+  if (!config_.imu.accelerometer) return;
+  if (gyro_.known && inertial_interval_known_) {
+    inertial_.update(inertial_interval_, attitude, reference_delta);
+  } else {
+    inertial_.forgetVelocity();
+  }
 }
 
 GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResult& result) {
@@ -132,6 +151,7 @@ GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResu
   const double half_sweep = 0.5 / config_.sensor.rotation_rate_hz;
   const double previous_reference = started_ ? last_stamp_ + last_reference_ : reference;
   GyroMotion gyro = imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep);
+  inertial_interval_known_ = gyro.known && preintegrateInterval(previous_reference, reference);
   if (!gyro.fallback.empty()) ++imu_fallbacks_[gyro.fallback];
   result.imu_fallback = gyro.fallback;
   imu_.forgetBefore(previous_reference - half_sweep);
@@ -213,8 +233,14 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
   ++refused_in_row_;
   result.delta = expSE3(held_velocity_ * dt);
   if (gyro_.known) result.delta.linear() = gyro_.rotation;
+  if (inertialPriorKnown()) {
+    result.delta.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
+  }
   result.pose = pose_ * result.delta;
   motion_.reset();
+  // The registrations the filter's velocity came from may have led it astray, as they did the prior:
+  // it is measured again from the registrations that follow, as the LiDAR's motion is.
+  if (config_.imu.enabled) inertial_.forgetVelocity();
   if (refused_in_row_ < static_cast<size_t>(config_.motion.restart_after)) return false;
   // The model no longer matches what the sensor sees: start again from this scan, where the prior puts it.
   const Vector6d held = held_velocity_;
@@ -260,6 +286,9 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   FrameResult result;
   followTimeline(cloud.stamp, result);
   if (!started_) first_stamp_ = cloud.stamp;
+  // A start, or a model restarted after a gap: the interval to this scan has no registration to carry
+  // the inertial filter's velocity over. Gravity and the bias stay, as the world frame does.
+  if (!started_ && config_.imu.enabled) inertial_.forgetVelocity();
   const double since_first = secondsSinceFirst(cloud.stamp);
 
   // Observation times are kept relative to the first scan: a float holds them to a millisecond for hours.
@@ -324,6 +353,7 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
       }
     } else {
       reference_delta = result.registration.model_from_scan;
+      if (config_.imu.enabled) followInertial(modelPose().linear(), reference_delta);
       stamp_in_reference = acceptRegistration(reference_delta, dt, deskewed_under, times, result);
       if (gyro_.known && result.registration.converged && !result.registration.degeneracy.any()) {
         imu_.learnBias(gyro_.rotation, reference_delta.linear(), dt);

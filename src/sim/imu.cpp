@@ -14,12 +14,18 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kStandardGravity = 9.81;  // m/s^2
 constexpr double kMicroG = 9.81e-6;        // m/s^2
 constexpr double kStep = 1e-3;             // s: the central differences' half step
+// s: the accelerometers read the mean acceleration over this window, as their anti-aliasing filter
+// (a bandwidth of about 50 Hz) makes a unit's do. The routes are piecewise linear (a sample every 5 cm):
+// differenced at a millisecond, each corner between route samples read as a spike of hundreds of m/s^2;
+// averaged, the window's acceleration integrates to the route's change of velocity.
+constexpr double kAccelerometerWindow = 0.02;
 
 Eigen::Vector3d gaussianVector(Rng& rng, double stddev) {
   return {rng.gaussian(0.0, stddev), rng.gaussian(0.0, stddev), rng.gaussian(0.0, stddev)};
 }
 
-// The IMU's true rate (its frame) and specific force at `t`, from its pose a step either side.
+// The IMU's true rate (its frame) from its pose a step either side of `t`, and its specific force at `t`:
+// the acceleration over kAccelerometerWindow, gravity included.
 ImuSample trueSample(const std::function<Eigen::Isometry3d(double)>& imu_pose_at, double t) {
   const Eigen::Isometry3d before = imu_pose_at(t - kStep);
   const Eigen::Isometry3d now = imu_pose_at(t);
@@ -27,8 +33,11 @@ ImuSample trueSample(const std::function<Eigen::Isometry3d(double)>& imu_pose_at
   ImuSample sample;
   sample.stamp = t;
   sample.angular_velocity = logSO3(before.linear().transpose() * after.linear()) / (2.0 * kStep);
-  const Eigen::Vector3d acceleration =
-      (after.translation() - 2.0 * now.translation() + before.translation()) / (kStep * kStep);
+  const auto velocity_at = [&](double time) -> Eigen::Vector3d {
+    return (imu_pose_at(time + kStep).translation() - imu_pose_at(time - kStep).translation()) / (2.0 * kStep);
+  };
+  const double half = 0.5 * kAccelerometerWindow;
+  const Eigen::Vector3d acceleration = (velocity_at(t + half) - velocity_at(t - half)) / kAccelerometerWindow;
   sample.specific_force = now.linear().transpose() * (acceleration + Eigen::Vector3d(0.0, 0.0, kStandardGravity));
   return sample;
 }

@@ -29,6 +29,13 @@ Piece turn(double degrees, double radius) {
 }
 
 // A road as a cycle of pieces repeated for as long as the drive needs.
+// How hard the vehicle is driven, m/s^2.
+struct DrivingLimits {
+  double lateral = kLateralAcceleration;
+  double acceleration = kAcceleration;
+  double deceleration = kDeceleration;
+};
+
 struct RoadDesign {
   std::vector<Piece> cycle;
   double stop_spacing = 0.0;  // m between stops; 0: no stops
@@ -36,7 +43,19 @@ struct RoadDesign {
   // The cycle is a closed circuit driven at cruise speed from the first frame: every lap retraces the
   // first exactly, in place and in time.
   bool closed_circuit = false;
+  DrivingLimits limits = DrivingLimits();
 };
+
+// A car driven hard through town: 0.8 g of braking, 3 m/s^2 of acceleration, 5 m/s^2 in the corners,
+// which are a town's (7-12 m radius), and a stop every 100 m: fast turns at low speed.
+RoadDesign hardDrivingDesign() {
+  RoadDesign design;
+  design.cycle = {straight(45.0), turn(90, 10.0), straight(35.0), turn(-90, 7.0), straight(60.0), turn(120, 12.0),
+                  straight(30.0), turn(-60, 8.0), straight(40.0), turn(-150, 9.0)};
+  design.stop_spacing = 100.0;
+  design.limits = {5.0, 3.0, 0.8 * 9.81};
+  return design;
+}
 
 // The turn radius the vehicle takes at cruise speed: tighter in town, wider on the highway.
 double comfortableRadius(double cruise_speed) {
@@ -84,6 +103,8 @@ RoadDesign designFor(TrajectoryKind kind, double cruise_speed) {
       return {{straight(150.0), turn(180, 8.0), straight(150.0), turn(180, 8.0)}};
     case TrajectoryKind::loop:
       return loopDesign(cruise_speed);
+    case TrajectoryKind::hard_driving:
+      return hardDrivingDesign();
   }
   throw std::invalid_argument("unknown trajectory kind");
 }
@@ -140,10 +161,11 @@ std::vector<Pose2> integratePath(const std::vector<double>& curvature) {
 
 // The fastest speed profile from rest under the cruise speed, the cornering limit, the stops, and
 // the acceleration and braking limits (a forward then a backward pass).
-std::vector<double> speedProfile(const std::vector<double>& curvature, double cruise_speed, double stop_spacing) {
+std::vector<double> speedProfile(const std::vector<double>& curvature, double cruise_speed, double stop_spacing,
+                                 const DrivingLimits& limits) {
   std::vector<double> speed(curvature.size());
   for (size_t i = 0; i < speed.size(); ++i) {
-    const double cornering = std::abs(curvature[i]) > 0.0 ? std::sqrt(kLateralAcceleration / std::abs(curvature[i]))
+    const double cornering = std::abs(curvature[i]) > 0.0 ? std::sqrt(limits.lateral / std::abs(curvature[i]))
                                                           : cruise_speed;
     speed[i] = std::min(cruise_speed, cornering);
   }
@@ -154,10 +176,10 @@ std::vector<double> speedProfile(const std::vector<double>& curvature, double cr
     for (size_t i = stride; i < speed.size(); i += stride) speed[i] = 0.0;
   }
   for (size_t i = 1; i < speed.size(); ++i) {
-    speed[i] = std::min(speed[i], std::sqrt(speed[i - 1] * speed[i - 1] + 2.0 * kAcceleration * kArcStep));
+    speed[i] = std::min(speed[i], std::sqrt(speed[i - 1] * speed[i - 1] + 2.0 * limits.acceleration * kArcStep));
   }
   for (size_t i = speed.size() - 1; i-- > 0;) {
-    speed[i] = std::min(speed[i], std::sqrt(speed[i + 1] * speed[i + 1] + 2.0 * kDeceleration * kArcStep));
+    speed[i] = std::min(speed[i], std::sqrt(speed[i + 1] * speed[i + 1] + 2.0 * limits.deceleration * kArcStep));
   }
   return speed;
 }
@@ -226,7 +248,7 @@ const std::map<std::string, TrajectoryKind>& trajectoryTable() {
       {"straight", TrajectoryKind::straight}, {"curves", TrajectoryKind::curves},
       {"roundabout", TrajectoryKind::roundabout}, {"hill", TrajectoryKind::hill},
       {"stop-and-go", TrajectoryKind::stop_and_go}, {"uturn", TrajectoryKind::uturn},
-      {"loop", TrajectoryKind::loop}};
+      {"loop", TrajectoryKind::loop}, {"hard-driving", TrajectoryKind::hard_driving}};
   return table;
 }
 }  // namespace
@@ -245,7 +267,7 @@ std::string trajectoryName(TrajectoryKind kind) {
 }
 
 std::vector<std::string> trajectoryNames() {
-  return {"straight", "curves", "roundabout", "hill", "stop-and-go", "uturn", "loop"};
+  return {"straight", "curves", "roundabout", "hill", "stop-and-go", "uturn", "loop", "hard-driving"};
 }
 
 double loopLapDuration(double cruise_speed) {
@@ -264,7 +286,7 @@ Route proceduralRoute(TrajectoryKind kind, double cruise_speed, double duration)
   // the way round, from the first frame on.
   const std::vector<double> speed = design.closed_circuit
                                         ? std::vector<double>(curvature.size(), cruise_speed)
-                                        : speedProfile(curvature, cruise_speed, design.stop_spacing);
+                                        : speedProfile(curvature, cruise_speed, design.stop_spacing, design.limits);
 
   std::vector<double> times{0.0};
   std::vector<Pose2> poses{path[0]};

@@ -26,7 +26,8 @@ const std::map<std::string, WorldFamily>& familyTable() {
                                                            {"highway", WorldFamily::highway},
                                                            {"country", WorldFamily::country},
                                                            {"parking", WorldFamily::parking},
-                                                           {"tunnel", WorldFamily::tunnel}};
+                                                           {"tunnel", WorldFamily::tunnel},
+                                                           {"indoor", WorldFamily::indoor}};
   return table;
 }
 
@@ -42,6 +43,8 @@ WorldRecipe recipeFor(WorldFamily family) {
       return parkingRecipe();
     case WorldFamily::tunnel:
       return tunnelRecipe();
+    case WorldFamily::indoor:
+      return indoorRecipe();
   }
   throw std::invalid_argument("unknown world family");
 }
@@ -142,7 +145,7 @@ std::string worldName(WorldFamily family) {
   throw std::invalid_argument("unknown world family");
 }
 
-std::vector<std::string> worldNames() { return {"urban", "highway", "country", "parking", "tunnel"}; }
+std::vector<std::string> worldNames() { return {"urban", "highway", "country", "parking", "tunnel", "indoor"}; }
 
 double cruiseSpeed(WorldFamily family) { return recipeFor(family).cruise_speed; }
 

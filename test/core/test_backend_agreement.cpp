@@ -431,9 +431,11 @@ TEST(BackendAgreement, RefusalsAndRecoveriesAgree) {
   EXPECT_EQ(odometry.cuda.recoveryCount(), odometry.cpu.recoveryCount());
 }
 
-// With an IMU (docs/imu.md) the gyro turns the guess and the deskew; the backends deskew and register
-// under the same velocities, so they agree as without it.
-TEST(BackendAgreement, PosesAgreeWithTheGyro) {
+// With an IMU (docs/imu.md) the gyro turns the guess and the deskew and the accelerometers carry the
+// guess's translation; the backends deskew and register under the same velocities and from the same
+// guesses, so they agree as without it. The samples are those of the drive's own motion: a circle at
+// 10 m/s and 0.3 rad/s, the specific force its 3 m/s^2 towards the centre and gravity.
+TEST(BackendAgreement, PosesAgreeWithTheImu) {
   ELO_REQUIRE_CUDA();
   Config config;
   config.imu.enabled = true;
@@ -448,6 +450,7 @@ TEST(BackendAgreement, PosesAgreeWithTheGyro) {
     ImuSample gyro;
     gyro.stamp = 0.005 * sample;
     gyro.angular_velocity = velocity.tail<3>();
+    gyro.specific_force = Eigen::Vector3d(0.0, velocity(0) * velocity(5), 9.81);
     cpu.addImu(gyro);
     cuda.addImu(gyro);
   }

@@ -63,5 +63,42 @@ TEST(SimulatedImu, AtRestTheAccelerometersReadGravityInTheImuAxes) {
   EXPECT_LT(samples.back().angular_velocity.norm(), 0.01);
 }
 
+// On the hard-driven car (0.8 g of braking, a route of straight pieces every 5 cm), a flawless unit's
+// accelerometers, integrated through its gyro over each 0.1 s, give the route's change of velocity: the
+// corners between route samples are averaged over the accelerometers' window, not read as spikes.
+TEST(SimulatedImu, TheAccelerometersIntegrateToTheHardDrivenCarsChangeOfVelocity) {
+  const Route route = proceduralRoute(TrajectoryKind::hard_driving, 10.0, 40.0);
+  const auto pose_at = [&route](double t) {
+    const Pose2 pose = route.at(t);
+    Eigen::Isometry3d lidar = Eigen::Isometry3d::Identity();
+    lidar.linear() = Eigen::AngleAxisd(pose.heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    lidar.translation() = Eigen::Vector3d(pose.x, pose.y, 1.5);
+    return lidar;
+  };
+  const ImuGrade flawless{"flawless", 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  ImuTrack track{ImuConfig()};
+  for (const ImuSample& sample : simulateImu(pose_at, 0.0, 40.0, 200.0, flawless, Eigen::Isometry3d::Identity(), 1)) {
+    ASSERT_EQ(track.add(sample), "");
+  }
+  const auto velocity_at = [&](double t) -> Eigen::Vector3d {
+    // The mean velocity over the accelerometers' 20 ms window, whose change they integrate to.
+    return (pose_at(t + 0.01).translation() - pose_at(t - 0.01).translation()) / 0.02;
+  };
+  double worst = 0.0, largest_change = 0.0;
+  for (double t = 1.0; t + 1.1 < 40.0; t += 0.1) {
+    Preintegration motion;
+    ASSERT_EQ(track.preintegrate(t, t + 1.0, motion), "");
+    const Eigen::Vector3d change =
+        pose_at(t).linear() * motion.velocity + Eigen::Vector3d(0.0, 0.0, -9.81) * motion.duration;
+    const Eigen::Vector3d truth = velocity_at(t + 1.0) - velocity_at(t);
+    worst = std::max(worst, (change - truth).norm());
+    largest_change = std::max(largest_change, truth.norm());
+  }
+  std::printf("[ sim imu  ] hard-driven car: velocity change over 1 s up to %.2f m/s, accelerometers off by %.3f m/s at most\n",
+              largest_change, worst);
+  EXPECT_GT(largest_change, 5.0);
+  EXPECT_LT(worst, 0.06);  // 0.041 m/s
+}
+
 }  // namespace
 }  // namespace elo::sim

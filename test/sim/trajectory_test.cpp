@@ -35,8 +35,10 @@ TEST(Route, ProceduralDrivesKeepRealisticSpeeds) {
       distance += speed * 0.05;
     }
     EXPECT_LE(fastest, 12.0 + 1e-6) << name;
-    EXPECT_GT(distance / 120.0, kind == TrajectoryKind::stop_and_go ? 6.0 : 7.0) << name;
-    if (kind == TrajectoryKind::stop_and_go) {
+    const bool stops = kind == TrajectoryKind::stop_and_go || kind == TrajectoryKind::hard_driving;
+    // The hard-driven car takes its town corners at 6-8 m/s and stops every 100 m.
+    EXPECT_GT(distance / 120.0, kind == TrajectoryKind::hard_driving ? 4.0 : stops ? 6.0 : 7.0) << name;
+    if (stops) {
       EXPECT_LT(slowest, 1e-9) << name << " never stops";
     } else {
       EXPECT_GT(slowest, 3.0) << name;
@@ -46,6 +48,30 @@ TEST(Route, ProceduralDrivesKeepRealisticSpeeds) {
   EXPECT_FALSE(trajectoryKindFromName("spiral"));
 }
 
+
+// Braking at 0.8 g, corners at 5 m/s^2 and a turn rate a car never reaches on the comfortable drives, at a
+// town's speeds: the speed over 0.5 s windows, the turn rate over 0.1 s.
+TEST(Route, TheHardDrivenCarBrakesAtPointEightGAndTurnsFastAtLowSpeed) {
+  const Route route = proceduralRoute(TrajectoryKind::hard_driving, 10.0, 60.0);
+  const double window = 0.5;
+  double hardest_braking = 0.0, hardest_cornering = 0.0, fastest_turn = 0.0, speed_at_fastest_turn = 0.0;
+  for (double t = 0.0; t + 2.0 * window < 60.0; t += 0.05) {
+    const double before = speedAt(route, t);
+    const double after = speedAt(route, t + window);
+    hardest_braking = std::max(hardest_braking, (before - after) / window);
+    const double turn_rate = std::abs(route.at(t + 0.1).heading - route.at(t).heading) / 0.1;
+    hardest_cornering = std::max(hardest_cornering, turn_rate * before);
+    if (turn_rate > fastest_turn) {
+      fastest_turn = turn_rate;
+      speed_at_fastest_turn = before;
+    }
+  }
+  EXPECT_NEAR(hardest_braking, 0.8 * 9.81, 0.5);
+  EXPECT_LT(hardest_cornering, 5.5);
+  EXPECT_GT(hardest_cornering, 4.0);
+  EXPECT_GT(fastest_turn * 180.0 / M_PI, 35.0);
+  EXPECT_LT(speed_at_fastest_turn, 8.0);
+}
 TEST(Route, TurnsOfEachDesign) {
   // A U-turn reverses the heading; a roundabout turns left by 90 deg net.
   const Route uturn = proceduralRoute(TrajectoryKind::uturn, 10.0, 60.0);

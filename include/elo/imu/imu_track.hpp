@@ -26,6 +26,7 @@ inline constexpr char kNotFinite[] = "IMU sample not finite";
 inline constexpr char kOutOfOrder[] = "IMU sample out of order";
 inline constexpr char kClockJump[] = "IMU clock went back over a second: samples before it forgotten";
 inline constexpr char kSaturated[] = "IMU sample saturated (imu.gyro_limit_dps)";
+inline constexpr char kAccelSaturated[] = "IMU sample saturated (imu.accel_limit)";
 inline constexpr char kNotCovered[] = "no IMU samples over the scan";
 inline constexpr char kGap[] = "IMU gap over the scan (imu.min_rate_hz)";
 }  // namespace imu_issue
@@ -49,6 +50,19 @@ struct GyroMotion {
   std::string fallback;
 };
 
+// The IMU's motion between two instants in the LiDAR frame at the first (its axes; the IMU's own point,
+// not the LiDAR's origin), the specific force integrated without gravity: what the accelerometers say
+// of a scan's translation (InertialFilter). `velocity` and `position` are less the learnt accelerometer
+// bias b (LiDAR axes) by `velocity_by_bias` b and `position_by_bias` b.
+struct Preintegration {
+  double duration = 0.0;                                              // s
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();             // the LiDAR's, by the gyro
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();                 // m/s: integral of R(t) f(t)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();                 // m: its integral
+  Eigen::Matrix3d velocity_by_bias = Eigen::Matrix3d::Zero();         // integral of R(t), s
+  Eigen::Matrix3d position_by_bias = Eigen::Matrix3d::Zero();         // its integral, s^2
+};
+
 class ImuTrack {
  public:
   explicit ImuTrack(const ImuConfig& config);
@@ -67,6 +81,9 @@ class ImuTrack {
   std::string rotation(double from, double to, Eigen::Matrix3d& rotation) const;
   // rotation() between the reference instants of two scans, and meanRate() over the later one's sweep.
   GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to) const;
+  // The gyro and the accelerometers integrated from `from` to `to` (the scans' clock), their rate and
+  // specific force linear between samples, into `motion`; returns why it cannot be, as rotation() does.
+  std::string preintegrate(double from, double to, Preintegration& motion) const;
   // Moves the gyro's bias estimate towards what makes its rotation `gyro` (from rotation()) over `dt`
   // seconds the registered rotation `registered` (both the LiDAR's), by imu.bias_time_constant.
   void learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt);
@@ -85,14 +102,16 @@ class ImuTrack {
  private:
   double max_gap_;
   double gyro_limit_;  // rad/s
+  double accel_limit_;  // m/s^2
   double time_offset_;
   Eigen::Vector3d gyro_bias_;
+  Eigen::Vector3d accel_bias_;
   Eigen::Matrix3d lidar_from_imu_;
   double bias_time_constant_;
   Eigen::Vector3d learnt_bias_ = Eigen::Vector3d::Zero();
   size_t bias_updates_ = 0;
   size_t taken_ = 0;
-  std::deque<ImuSample> samples_;  // the scans' clock, bias removed, in time order
+  std::deque<ImuSample> samples_;  // the scans' clock, biases removed, in time order
   std::map<std::string, size_t> dropped_;
 };
 

@@ -12,6 +12,7 @@
 #include "elo/config.hpp"
 #include "elo/pipeline/deskew.hpp"
 #include "elo/imu/imu_track.hpp"
+#include "elo/imu/inertial_filter.hpp"
 #include "elo/pipeline/motion_prior.hpp"
 #include "elo/pipeline/registration.hpp"
 #include "elo/sensor/sensor_height_check.hpp"
@@ -141,6 +142,9 @@ class Odometry {
   const std::map<std::string, size_t>& imuDroppedCounts() const { return imu_.droppedCounts(); }
   // The IMU's state in one struct, for the node's diagnostics.
   ImuStatus imuStatus() const;
+  // With imu.accelerometer: gravity in the odometry's world frame (the first scan's), the IMU's velocity
+  // and the accelerometers' bias as estimated so far (InertialFilter; started() once a scan was registered).
+  const InertialFilter& inertialState() const { return inertial_; }
 
   // A scan filling fewer pixels of its range image than three full rows (normals.min_window_height rows
   // of sensor.image_width) is skipped as "too few valid points". It cannot give surface normals over
@@ -212,6 +216,16 @@ class Odometry {
   // scan, between their reference instants, and its mean rate over the sweep; a fallback is counted and
   // put in `result`. Nothing without imu.enabled.
   GyroMotion gyroMotion(double stamp, const CloudTimes& times, FrameResult& result);
+  // The IMU's motion between the last accepted scan's reference instant and this scan's (imu.accelerometer;
+  // samples covering it, as the gyro's), into inertial_interval_; whether it is known.
+  bool preintegrateInterval(double previous_reference, double reference);
+  // Whether the accelerometers give this scan's translation: the IMU covered its interval and the inertial
+  // filter's velocity is known.
+  bool inertialPriorKnown() const { return inertial_interval_known_ && inertial_.ready(); }
+  // The accepted registration `reference_delta` corrects the inertial filter, which moves on to this scan
+  // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
+  // reference frame in the world.
+  void followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta);
   // `velocity` (a sweep's twist per second) turning at the gyro's rate over the scan's sweep, when known.
   Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
@@ -254,6 +268,9 @@ class Odometry {
   size_t tracking_restarts_ = 0;
   ImuTrack imu_;
   GyroMotion gyro_;  // of the scan being processed
+  InertialFilter inertial_;
+  Preintegration inertial_interval_;  // of the scan being processed, since the last accepted one
+  bool inertial_interval_known_ = false;
   std::map<std::string, size_t> imu_fallbacks_;
 };
 

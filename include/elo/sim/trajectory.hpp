@@ -48,7 +48,10 @@ class Route {
 
 // `loop` laps a closed circuit at cruise speed from the first frame, each lap the same in place and
 // time: a sequence of exactly one lap replayed end to end is one continuous drive (the soak test).
-enum class TrajectoryKind { straight, curves, roundabout, hill, stop_and_go, uturn, loop };
+// `hard_driving`: a car driven hard through town: braking at 0.8 g to a stop every
+// ~100 m, accelerating at 3 m/s^2, and turning corners of 7-12 m radius at 5 m/s^2 of lateral acceleration
+// (up to 45 deg/s of yaw at 6-8 m/s).
+enum class TrajectoryKind { straight, curves, roundabout, hill, stop_and_go, uturn, loop, hard_driving };
 
 std::optional<TrajectoryKind> trajectoryKindFromName(const std::string& name);
 std::string trajectoryName(TrajectoryKind kind);

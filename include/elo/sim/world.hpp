@@ -17,7 +17,7 @@
 
 namespace elo::sim {
 
-enum class WorldFamily { urban, highway, country, parking, tunnel };
+enum class WorldFamily { urban, highway, country, parking, tunnel, indoor };
 struct WorldRecipe;
 
 std::optional<WorldFamily> worldFamilyFromName(const std::string& name);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "elo/se3.hpp"
 
@@ -38,8 +39,11 @@ Eigen::Matrix3d lidarFromImuRotation(const ImuConfig& config) {
 ImuTrack::ImuTrack(const ImuConfig& config)
     : max_gap_(2.0 / config.min_rate_hz),
       gyro_limit_(config.gyro_limit_dps * kDegToRad),
+      // Without the accelerometers, their saturation does not touch the gyro's samples.
+      accel_limit_(config.accelerometer ? config.accel_limit : std::numeric_limits<double>::infinity()),
       time_offset_(config.time_offset),
       gyro_bias_(config.gyro_bias.size() == 3 ? vectorOf(config.gyro_bias) : Eigen::Vector3d::Zero()),
+      accel_bias_(config.accel_bias.size() == 3 ? vectorOf(config.accel_bias) : Eigen::Vector3d::Zero()),
       lidar_from_imu_(config.rotation_deg.size() == 3 ? lidarFromImuRotation(config) : Eigen::Matrix3d::Identity()),
       bias_time_constant_(config.bias_time_constant) {}
 
@@ -51,6 +55,8 @@ std::string ImuTrack::add(const ImuSample& sample) {
     issue = imu_issue::kNotFinite;
   } else if (sample.angular_velocity.cwiseAbs().maxCoeff() >= gyro_limit_) {
     issue = imu_issue::kSaturated;
+  } else if (sample.specific_force.cwiseAbs().maxCoeff() >= accel_limit_) {
+    issue = imu_issue::kAccelSaturated;
   } else if (!samples_.empty() && sample.stamp + time_offset_ <= samples_.back().stamp) {
     // Far behind: a bag played again or a clock reset, as the odometry's reset() takes a scan stamped
     // before the last; the samples held describe another time.
@@ -68,6 +74,7 @@ std::string ImuTrack::add(const ImuSample& sample) {
   ImuSample taken = sample;
   taken.stamp += time_offset_;
   taken.angular_velocity -= gyro_bias_;
+  taken.specific_force -= accel_bias_;
   samples_.push_back(taken);
   ++taken_;
   return {};
@@ -106,6 +113,45 @@ GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, dou
   motion.known = motion.fallback.empty();
   if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
   return motion;
+}
+
+std::string ImuTrack::preintegrate(double from, double to, Preintegration& motion) const {
+  const auto before = [](const ImuSample& sample, double time) { return sample.stamp < time; };
+  if (samples_.empty() || samples_.front().stamp > from || samples_.back().stamp < to) return imu_issue::kNotCovered;
+  size_t i = static_cast<size_t>(std::lower_bound(samples_.begin(), samples_.end(), from, before) - samples_.begin());
+  if (i == samples_.size() || samples_[i].stamp > from) --i;
+  // In the IMU's axes, then turned into the LiDAR's; each piece by its midpoint's rotation.
+  Preintegration imu;
+  imu.duration = to - from;
+  for (; i + 1 < samples_.size() && samples_[i].stamp < to; ++i) {
+    const ImuSample& s0 = samples_[i];
+    const ImuSample& s1 = samples_[i + 1];
+    if (s1.stamp - s0.stamp > max_gap_) return imu_issue::kGap;
+    const double a = std::max(from, s0.stamp);
+    const double b = std::min(to, s1.stamp);
+    if (b <= a) continue;
+    const auto at = [&](const Eigen::Vector3d& v0, const Eigen::Vector3d& v1, double t) -> Eigen::Vector3d {
+      return v0 + (v1 - v0) * ((t - s0.stamp) / (s1.stamp - s0.stamp));
+    };
+    const double h = b - a;
+    const double middle = 0.5 * (a + b);
+    const Eigen::Vector3d rate = at(s0.angular_velocity, s1.angular_velocity, middle) - learnt_bias_;
+    const Eigen::Matrix3d turn_at_middle = imu.rotation * rotationOf(0.5 * h * rate);
+    const Eigen::Vector3d force = turn_at_middle * at(s0.specific_force, s1.specific_force, middle);
+    imu.position += imu.velocity * h + 0.5 * force * h * h;
+    imu.velocity += force * h;
+    imu.position_by_bias += imu.velocity_by_bias * h + 0.5 * turn_at_middle * h * h;
+    imu.velocity_by_bias += turn_at_middle * h;
+    imu.rotation = imu.rotation * rotationOf(h * rate);
+  }
+  const Eigen::Matrix3d& axes = lidar_from_imu_;
+  motion.duration = imu.duration;
+  motion.rotation = axes * imu.rotation * axes.transpose();
+  motion.velocity = axes * imu.velocity;
+  motion.position = axes * imu.position;
+  motion.velocity_by_bias = axes * imu.velocity_by_bias * axes.transpose();
+  motion.position_by_bias = axes * imu.position_by_bias * axes.transpose();
+  return {};
 }
 
 void ImuTrack::learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt) {

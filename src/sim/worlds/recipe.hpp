@@ -38,6 +38,7 @@ WorldRecipe highwayRecipe();
 WorldRecipe countryRecipe();
 WorldRecipe parkingRecipe();
 WorldRecipe tunnelRecipe();
+WorldRecipe indoorRecipe();
 
 // Smooth step from 0 at `begin` to 1 at `end` (zero slope at both ends).
 inline double smoothStep(double begin, double end, double x) {
