@@ -165,6 +165,7 @@ void Odometry::setImuMount(const std::vector<double>& position, const std::vecto
   validate(mounted);
   config_ = std::move(mounted);
   imu_.setMount(config_.imu);
+  inertial_.setMount(config_.imu);
 }
 
 ImuStatus Odometry::imuStatus() const {
@@ -173,6 +174,9 @@ ImuStatus Odometry::imuStatus() const {
   status.dropped = imu_.droppedCounts();
   status.fallbacks = imu_fallbacks_;
   status.gyro_bias = imu_.biasEstimate();
+  status.gravity_known = inertial_.started();
+  status.gravity = inertial_.gravity();
+  status.accel_bias = imu_.accelBiasSet() + inertial_.learntBias();
   return status;
 }
 

@@ -17,13 +17,14 @@ size_t total(const std::map<std::string, size_t>& counts) {
   return sum;
 }
 
-std::string degreesPerSecond(const Eigen::Vector3d& rate) {
+std::string vectorText(const Eigen::Vector3d& vector) {
   std::ostringstream text;
   text.precision(4);
-  const Eigen::Vector3d degrees = rate * 180.0 / M_PI;
-  text << degrees.x() << ", " << degrees.y() << ", " << degrees.z();
+  text << vector.x() << ", " << vector.y() << ", " << vector.z();
   return text.str();
 }
+
+std::string degreesPerSecond(const Eigen::Vector3d& rate) { return vectorText(rate * 180.0 / M_PI); }
 
 }  // namespace
 
@@ -233,6 +234,8 @@ void ImuStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("scans on the LiDAR-only prior", fallbacks);
   for (const auto& [reason, count] : core_.fallbacks) status.add("scans on the LiDAR-only prior: " + reason, count);
   status.add("gyro bias (deg/s)", degreesPerSecond(core_.gyro_bias));
+  status.add("gravity in the odometry frame (m/s^2)", core_.gravity_known ? vectorText(core_.gravity) : "not estimated yet");
+  status.add("accelerometer bias (m/s^2)", vectorText(core_.accel_bias));
 
   reported_fallbacks_ = fallbacks;
   reported_dropped_ = dropped;

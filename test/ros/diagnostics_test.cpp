@@ -164,6 +164,14 @@ TEST(RosDiagnostics, ImuAtItsRateIsOkAndSilenceSlownessAndFallbacksWarn) {
   EXPECT_EQ(valueOf(steady, "Imu messages received"), "201");
   EXPECT_EQ(valueOf(steady, "IMU samples taken"), "200");
   EXPECT_EQ(valueOf(steady, "gyro bias (deg/s)"), "1, 0, -0.5");
+  EXPECT_EQ(valueOf(steady, "gravity in the odometry frame (m/s^2)"), "not estimated yet");
+  core.gravity_known = true;
+  core.gravity = {0.0, -0.5, -9.79};
+  core.accel_bias = {0.05, 0.0, -0.02};
+  statistics.update(core);
+  const diagnostic_updater::DiagnosticStatusWrapper started = imuStatusAfter(statistics, 201, 0.005);
+  EXPECT_EQ(valueOf(started, "gravity in the odometry frame (m/s^2)"), "0, -0.5, -9.79");
+  EXPECT_EQ(valueOf(started, "accelerometer bias (m/s^2)"), "0.05, 0, -0.02");
   EXPECT_EQ(valueOf(steady, "scans on the LiDAR-only prior"), "0");
 
   const diagnostic_updater::DiagnosticStatusWrapper silent = imuStatusAfter(statistics, 0, 0.005);

@@ -38,6 +38,12 @@ struct ImuStatus {
   std::map<std::string, size_t> dropped;     // samples, by imu_issue
   std::map<std::string, size_t> fallbacks;   // scans the gyro could not turn, by imu_issue
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // rad/s, the IMU's axes: imu.gyro_bias and the bias learnt
+  // The accelerometers' filter (imu.accelerometer; InertialFilter), once it has started: gravity in the
+  // odometry's world frame (the first scan's, m/s^2) and the accelerometers' bias (m/s^2, the IMU's axes:
+  // imu.accel_bias and the bias learnt).
+  bool gravity_known = false;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();
 };
 
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
@@ -89,6 +95,8 @@ class ImuTrack {
   void learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt);
   // The gyro's bias estimated online (rad/s, the IMU's axes), on top of imu.gyro_bias.
   const Eigen::Vector3d& learntBias() const { return learnt_bias_; }
+  // imu.accel_bias (m/s^2, the IMU's axes), removed from every sample taken.
+  const Eigen::Vector3d& accelBiasSet() const { return accel_bias_; }
   // Forgets the samples before `stamp` (the scans' clock) but the last one at or before it.
   void forgetBefore(double stamp);
 

@@ -23,6 +23,9 @@ namespace elo {
 class InertialFilter {
  public:
   explicit InertialFilter(const ImuConfig& config);
+  // The mount (imu.position, imu.rotation_deg) known once running (the node's, from TF): what the filter
+  // holds is forgotten, its bias being in the axes of the mount it had.
+  void setMount(const ImuConfig& config);
 
   // Whether gravity has been taken (the filter started), and the velocity known from two registrations
   // in a row: one alone may be a start search's wrong motion, which the next is refused against.

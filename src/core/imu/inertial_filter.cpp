@@ -25,10 +25,16 @@ Eigen::Vector3d vectorOf(const std::vector<double>& values) { return {values[0],
 }  // namespace
 
 InertialFilter::InertialFilter(const ImuConfig& config)
-    : lever_(config.position.size() == 3 ? vectorOf(config.position) : Eigen::Vector3d::Zero()),
-      lidar_from_imu_(config.rotation_deg.size() == 3 ? lidarFromImuRotation(config) : Eigen::Matrix3d::Identity()),
-      bias_walk_(config.accel_bias_time_constant > 0.0 ? kBiasPrior * kBiasPrior / config.accel_bias_time_constant
-                                                        : 0.0) {}
+    : bias_walk_(config.accel_bias_time_constant > 0.0 ? kBiasPrior * kBiasPrior / config.accel_bias_time_constant
+                                                        : 0.0) {
+  setMount(config);
+}
+
+void InertialFilter::setMount(const ImuConfig& config) {
+  lever_ = config.position.size() == 3 ? vectorOf(config.position) : Eigen::Vector3d::Zero();
+  lidar_from_imu_ = config.rotation_deg.size() == 3 ? lidarFromImuRotation(config) : Eigen::Matrix3d::Identity();
+  reset();
+}
 
 Eigen::Vector3d InertialFilter::predictTranslation(const Preintegration& motion, const Eigen::Matrix3d& attitude,
                                                    const Eigen::Matrix3d& rotation) const {
