@@ -144,11 +144,13 @@ Vector6d Odometry::withGyroRate(Vector6d velocity) const {
 
 size_t Odometry::projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
                                  FrameResult& result) {
-  const size_t occupied = backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
-  if (occupied >= minOccupiedPixels() || velocity.isZero()) return occupied;
+  // With the gyro, each point turned by its rotation at the point's own time (the velocity's rate serves
+  // the translation's own turn only).
+  const size_t occupied = backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference, gyro_.sweep});
+  if (occupied >= minOccupiedPixels() || (velocity.isZero() && !gyro_.sweep.known())) return occupied;
   velocity.setZero();
   result.projected_without_deskew = true;
-  return backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
+  return backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference, {}});
 }
 
 Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& reference_delta, double dt,
@@ -263,7 +265,7 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   gyro_ = gyroMotion(cloud.stamp, times, result);
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured. With an
-  // IMU, turning at the gyro's rate over the sweep.
+  // IMU, turned by the gyro's rotation through the sweep.
   Vector6d sweep_velocity = withGyroRate(started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero());
   const size_t occupied = projectDeskewed(cloud, relative_stamp, times, sweep_velocity, result);
   result.times.projection = millisecondsSince(stage_start);

@@ -85,15 +85,29 @@ void redeskewEachPixel(const SweepVelocity& applied, const SweepVelocity& veloci
   }
 }
 
-}  // namespace
+void redeskewEachPixel(const SweepRotation& rotation, const SweepVelocity& velocity, const PixelBlock& block) {
+  for (size_t pixel = block.begin; pixel < block.end; ++pixel) {
+    if (block.range[pixel] <= 0.0f) continue;
+    Float3 vertex;
+    redeskewPixel(rotation, velocity, toFloat3(block.measured[pixel]), block.time[pixel], vertex, block.range[pixel]);
+    block.vertex[pixel] = toVec3f(vertex);
+  }
+}
 
-void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+template <typename Redeskew>
+void forEachBlock(ScanImage& scan, const Redeskew& redeskew) {
   SphericalImage& image = scan.image;
   const size_t pixels = image.pixelCount();
   parallelFor((pixels + kBlock - 1) / kBlock, [&](size_t index) {
-    const PixelBlock block{scan.measured.data(), scan.time.data(),   image.vertex.data(),
-                           image.range.data(),   image.normal.data(), index * kBlock,
-                           std::min(pixels, (index + 1) * kBlock)};
+    redeskew(PixelBlock{scan.measured.data(), scan.time.data(), image.vertex.data(), image.range.data(),
+                        image.normal.data(), index * kBlock, std::min(pixels, (index + 1) * kBlock)});
+  });
+}
+
+}  // namespace
+
+void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+  forEachBlock(scan, [&](const PixelBlock& block) {
     const BlockContents contents = contentsOf(applied, velocity, block);
     if (!contents.occupied) return;
     if (contents.turns_little) {
@@ -102,6 +116,10 @@ void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, Sca
       redeskewEachPixel(applied, velocity, block);
     }
   });
+}
+
+void deskewScan(const SweepRotation& rotation, const SweepVelocity& velocity, ScanImage& scan) {
+  forEachBlock(scan, [&](const PixelBlock& block) { redeskewEachPixel(rotation, velocity, block); });
 }
 
 }  // namespace elo::cpu

@@ -82,10 +82,11 @@ struct PlacedLanes {
 
 // scanPointVertex() of the points [first, first + kPixelLanes) of `xyz` (x, y, z after one another),
 // each one's measured point, time and vertex into `placed`, bit for bit. False, with the group's vertices
-// not computed, where a point that has a time turns by more than the short series' bound: the caller
-// places that group point by point.
+// not computed, where a point that has a time turns by more than the short series' bound, or where the
+// gyro turns the sweep (SweepRotation): the caller places that group point by point.
 inline bool placeLanes(const ElevationCorrection& correction, const SweepDeskew& deskew, const float* xyz,
                        size_t first, ScanPoint* placed, PlacedLanes& group) {
+  if (deskew.rotation.known) return false;
   __m256 raw_x, raw_y, raw_z;
   loadPointLanes(xyz + 3 * first, raw_x, raw_y, raw_z);
   const unsigned finite = finiteLanes(raw_x, raw_y, raw_z);

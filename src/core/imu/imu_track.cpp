@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "elo/se3.hpp"
 
@@ -94,12 +95,48 @@ std::string ImuTrack::rotation(double from, double to, Eigen::Matrix3d& rotation
   return {};
 }
 
+Eigen::Vector3d ImuTrack::rateAt(double time) const {
+  const auto before = [](const ImuSample& sample, double t) { return sample.stamp < t; };
+  size_t i = static_cast<size_t>(std::lower_bound(samples_.begin(), samples_.end(), time, before) - samples_.begin());
+  i = std::min(std::max<size_t>(i, 1), samples_.size() - 1);
+  const ImuSample& a = samples_[i - 1];
+  const ImuSample& b = samples_[i];
+  const double share = b.stamp > a.stamp ? (time - a.stamp) / (b.stamp - a.stamp) : 0.0;
+  return lidar_from_imu_ * (a.angular_velocity + (b.angular_velocity - a.angular_velocity) * share - learnt_bias_);
+}
+
+std::string ImuTrack::sweepRotation(double reference, double from, double to, GyroSweep& sweep) const {
+  constexpr int kKnots = GyroSweep::kIntervals + 1;
+  const double step = (to - from) / GyroSweep::kIntervals;
+  // Each knot's frame in the first knot's, interval after interval, then in the reference's.
+  std::vector<Eigen::Matrix3d> from_first(kKnots, Eigen::Matrix3d::Identity());
+  for (int k = 1; k < kKnots; ++k) {
+    Eigen::Matrix3d interval;
+    const std::string issue = rotation(from + (k - 1) * step, from + k * step, interval);
+    if (!issue.empty()) return issue;
+    from_first[k] = from_first[k - 1] * interval;
+  }
+  Eigen::Matrix3d reference_from_first;
+  const std::string issue = rotation(from, reference, reference_from_first);
+  if (!issue.empty()) return issue;
+  sweep.first = from - reference;
+  sweep.last = to - reference;
+  sweep.rotations.clear();
+  sweep.rates.clear();
+  for (int k = 0; k < kKnots; ++k) {
+    sweep.rotations.push_back(reference_from_first.transpose() * from_first[k]);
+    sweep.rates.push_back(rateAt(from + k * step));
+  }
+  return {};
+}
+
 GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, double sweep_from,
                                 double sweep_to) const {
   GyroMotion motion;
   Eigen::Matrix3d over_sweep;
   motion.fallback = rotation(previous_reference, reference, motion.rotation);
   if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
+  if (motion.fallback.empty()) motion.fallback = sweepRotation(reference, sweep_from, sweep_to, motion.sweep);
   motion.known = motion.fallback.empty();
   if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
   return motion;
