@@ -130,7 +130,8 @@ GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResu
   const double reference = stamp + times.reference;
   const double half_sweep = 0.5 / config_.sensor.rotation_rate_hz;
   const double previous_reference = started_ ? last_stamp_ + last_reference_ : reference;
-  GyroMotion gyro = imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep);
+  GyroMotion gyro =
+      imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep, stamp);
   if (!gyro.fallback.empty()) ++imu_fallbacks_[gyro.fallback];
   result.imu_fallback = gyro.fallback;
   imu_.forgetBefore(previous_reference - half_sweep);
@@ -158,7 +159,10 @@ Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& referenc
                                                FrameResult& result) {
   // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference` seconds
   // before the reference instant) is exp(-reference * velocity) in the reference frame.
-  const Eigen::Isometry3d stamp_in_reference = expSE3(-times.reference * deskewed_under);
+  Eigen::Isometry3d stamp_in_reference = expSE3(-times.reference * deskewed_under);
+  // With a gyro, the turn it measured between the two instants: the velocity's rate is its mean over the
+  // sweep, which the stamp at one end of a sweep swung at a changing rate would miss by up to a degree.
+  if (gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   // The first scan of a start had no velocity to place its stamp in its sweep; registered against it as
   // measured (bent alike), this scan measured the motion between like instants of the two sweeps.
   if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);

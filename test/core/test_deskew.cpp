@@ -377,7 +377,7 @@ class SweepTurningFaster : public ::testing::TestWithParam<TimeSource> {
 };
 
 TEST_P(SweepTurningFaster, TheGyroRecoversEveryPointToFloatPrecisionWhereItsMeanRateDoesNot) {
-  const GyroMotion gyro = track_->scanMotion(-0.1, 0.0, -0.05, 0.05);
+  const GyroMotion gyro = track_->scanMotion(-0.1, 0.0, -0.05, 0.05, 0.0);
   ASSERT_TRUE(gyro.known) << gyro.fallback;
   ASSERT_TRUE(gyro.sweep.known());
   Vector6d mean_rate = Vector6d::Zero();

@@ -33,13 +33,16 @@ inline constexpr char kGap[] = "IMU gap over the scan (imu.min_rate_hz)";
 }  // namespace imu_issue
 
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
-// instants), its mean rate over the scan's sweep and its rotation through the sweep, in the LiDAR's frame.
+// instants), its mean rate over the scan's sweep, its rotation through the sweep and at the scan's stamp,
+// in the LiDAR's frame.
 // Known when the samples cover both; else `fallback` says why (empty without imu.enabled).
 struct GyroMotion {
   bool known = false;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d sweep_rate = Eigen::Vector3d::Zero();  // rad/s
   GyroSweep sweep;
+  // The frame at the scan's stamp in the frame at its reference instant (the reported pose's turn).
+  Eigen::Matrix3d stamp_rotation = Eigen::Matrix3d::Identity();
   std::string fallback;
 };
 
@@ -60,9 +63,10 @@ class ImuTrack {
   // times from `reference`): rotation() between the knots, the rate linear between samples. Returns why
   // it cannot be, or empty, as rotation() does.
   std::string sweepRotation(double reference, double from, double to, GyroSweep& sweep) const;
-  // rotation() between the reference instants of two scans, and the mean rate and sweepRotation() over
-  // the later one's sweep.
-  GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to) const;
+  // rotation() between the reference instants of two scans, the mean rate and sweepRotation() over the
+  // later one's sweep, and its rotation between its reference instant and its `stamp`.
+  GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to,
+                        double stamp) const;
   // Moves the gyro's bias estimate towards what makes its rotation `gyro` (from rotation()) over `dt`
   // seconds the registered rotation `registered` (both the LiDAR's), by imu.bias_time_constant.
   void learnBias(const Eigen::Matrix3d& gyro, const Eigen::Matrix3d& registered, double dt);

@@ -107,12 +107,13 @@ Eigen::Vector3d ImuTrack::rateAt(double time) const {
 
 std::string ImuTrack::sweepRotation(double reference, double from, double to, GyroSweep& sweep) const {
   constexpr int kKnots = GyroSweep::kIntervals + 1;
-  const double step = (to - from) / GyroSweep::kIntervals;
+  // The last knot at `to` itself: the samples cover that much, and maybe not a rounding beyond.
+  const auto knot = [&](int k) { return k == GyroSweep::kIntervals ? to : from + k * (to - from) / GyroSweep::kIntervals; };
   // Each knot's frame in the first knot's, interval after interval, then in the reference's.
   std::vector<Eigen::Matrix3d> from_first(kKnots, Eigen::Matrix3d::Identity());
   for (int k = 1; k < kKnots; ++k) {
     Eigen::Matrix3d interval;
-    const std::string issue = rotation(from + (k - 1) * step, from + k * step, interval);
+    const std::string issue = rotation(knot(k - 1), knot(k), interval);
     if (!issue.empty()) return issue;
     from_first[k] = from_first[k - 1] * interval;
   }
@@ -125,18 +126,22 @@ std::string ImuTrack::sweepRotation(double reference, double from, double to, Gy
   sweep.rates.clear();
   for (int k = 0; k < kKnots; ++k) {
     sweep.rotations.push_back(reference_from_first.transpose() * from_first[k]);
-    sweep.rates.push_back(rateAt(from + k * step));
+    sweep.rates.push_back(rateAt(knot(k)));
   }
   return {};
 }
 
 GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, double sweep_from,
-                                double sweep_to) const {
+                                double sweep_to, double stamp) const {
   GyroMotion motion;
   Eigen::Matrix3d over_sweep;
   motion.fallback = rotation(previous_reference, reference, motion.rotation);
   if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
   if (motion.fallback.empty()) motion.fallback = sweepRotation(reference, sweep_from, sweep_to, motion.sweep);
+  if (motion.fallback.empty()) {
+    motion.fallback = rotation(std::min(stamp, reference), std::max(stamp, reference), motion.stamp_rotation);
+    if (stamp < reference) motion.stamp_rotation.transposeInPlace();
+  }
   motion.known = motion.fallback.empty();
   if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
   return motion;
