@@ -521,7 +521,9 @@ TEST(BackendAgreement, DeskewWithTheGyroMovesThePointsAlike) {
 TEST(BackendAgreement, PosesAgreeWithTheGyroTurningWithinEachSweep) {
   ELO_REQUIRE_CUDA();
   constexpr double kSwingPeriod = 0.4;
-  const auto angle = [](double t) { return 1.5 * t - kSwingPeriod / (2.0 * M_PI) * std::cos(2.0 * M_PI * t / kSwingPeriod); };
+  const auto angle = [](double t) {
+    return 1.5 * t - kSwingPeriod / (2.0 * M_PI) * std::cos(2.0 * M_PI * t / kSwingPeriod);
+  };
   const auto rate = [](double t) { return 1.5 + std::sin(2.0 * M_PI * t / kSwingPeriod); };
   for (const RegistrationMode mode : {RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame}) {
     SCOPED_TRACE(mode == RegistrationMode::frame_to_model ? "frame-to-model" : "frame-to-frame");

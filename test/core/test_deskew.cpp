@@ -170,8 +170,9 @@ TEST(Deskew, TheCpuPassOverPixelsGivesEachPixelThePerPixelMath) {
 // (deskew_lanes.hpp): each lane gets scanPointVertex()'s measured point, time and vertex, bit for bit,
 // and the lanes with a point are the points scanPointVertex() places (finite, with a time of the sweep).
 // Times from a field (some outside the sweep, some NaN) and from the azimuth, with and without KITTI's
-// elevation correction, at rest, driving, and in a sharp turn, which sends the groups that hold a point
-// more than 40 ms from the reference back to placing point by point.
+// elevation correction, at rest, driving, in a sharp turn, which sends the groups that hold a point
+// more than 40 ms from the reference back to placing point by point, and swung with a gyro's rotation
+// (times in lanes, each point turned by the shared function).
 TEST(Deskew, PointsPlacedEightAtOnceAreThoseOfTheSharedMath) {
   constexpr size_t kGroups = 2000;
   constexpr size_t kPoints = kGroups * cpu::kPixelLanes;
@@ -187,17 +188,31 @@ TEST(Deskew, PointsPlacedEightAtOnceAreThoseOfTheSharedMath) {
   }
   Vector6d sharp_turn;  // turning little only within 40 ms of the reference
   sharp_turn << 8.0, 0.0, 0.0, 0.0, 0.0, 0.8;
+  // Swung at 180 deg/s, the rate rising by half within the sweep, turned by a gyro's rotation.
+  Vector6d swung;
+  swung << 1.4, 0.0, 0.0, 0.0, 0.0, M_PI;
+  ImuTrack gyro{ImuConfig()};
+  for (int i = -40; i <= 40; ++i) {
+    ImuSample sample;
+    sample.stamp = 0.005 * i;
+    sample.angular_velocity = Eigen::Vector3d(0.0, 0.0, M_PI + 5.0 * M_PI * sample.stamp);
+    gyro.add(sample);
+  }
+  GyroSweep swing;
+  ASSERT_EQ(gyro.sweepRotation(0.0, -0.05, 0.05, swing), "");
   SensorConfig sensor;
   for (const double correction_deg : {0.0, 0.195}) {
     sensor.elevation_correction_deg = correction_deg;
     const ElevationCorrection correction = ElevationCorrection::fromConfig(sensor);
     for (const TimeSource source : {TimeSource::field, TimeSource::azimuth}) {
-      for (const Vector6d& twist : {Vector6d::Zero().eval(), drivingVelocity(), sharp_turn}) {
+      for (const Vector6d& twist : {Vector6d::Zero().eval(), drivingVelocity(), sharp_turn, swung}) {
         const bool turns_sharply = twist == sharp_turn;
         SCOPED_TRACE(std::string(source == TimeSource::field ? "field" : "azimuth") + " times, correction " +
-                     std::to_string(correction_deg) + (turns_sharply ? ", sharp turn" : twist.isZero() ? ", at rest" : ""));
-        const SweepDeskew deskew{SweepTiming::fromConfig(sensor, source),
-                                 source == TimeSource::field ? times.data() : nullptr, toSweepVelocity(twist)};
+                     std::to_string(correction_deg) +
+                     (turns_sharply ? ", sharp turn" : twist == swung ? ", swung" : twist.isZero() ? ", at rest" : ""));
+        SweepDeskew deskew{SweepTiming::fromConfig(sensor, source),
+                           source == TimeSource::field ? times.data() : nullptr, toSweepVelocity(twist)};
+        if (twist == swung) deskew.rotation = toSweepRotation(swing);
         std::vector<ScanPoint> placed(kPoints);
         size_t groups_in_lanes = 0;
         size_t points_placed = 0;

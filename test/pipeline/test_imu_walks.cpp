@@ -174,7 +174,8 @@ TEST_F(ImuWalk, TheGyroAtEachPointsTimeHalvesTheDeskewError) {
     ++scored;
   }
   for (double& sum : error) sum /= scored;
-  std::printf("[ imu deskew ] VLP-16 swung sweeps, %d scans, a point's mean distance from its true place (worst scan):\n"
+  std::printf("[ imu deskew ] VLP-16 swung sweeps, %d scans, a point's mean distance from its true place "
+              "(worst scan):\n"
               "  LiDAR only, the velocity of the interval before: %.1f mm (%.1f)\n"
               "  LiDAR only, the scan's own velocity:            %.1f mm (%.1f)\n"
               "  the gyro's mean rate over the sweep:            %.1f mm (%.1f)\n"

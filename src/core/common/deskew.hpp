@@ -99,7 +99,8 @@ ELO_HOST_DEVICE inline Float3 deskewDirection(const SweepVelocity& velocity, flo
 // interval k, `within` seconds after its start, the frame is rotation_k exp(turn), turn = mean_rate_k within
 // + rate_change_k within (within - step): rotation_{k+1} at its end, the rate linear in time between the
 // gyro's rates at the two knots (exact for a rate linear in time about a fixed axis). Before the first and
-// after the last knot, the end interval's mean rate. Passed by value to the kernels: 1,040 bytes.
+// after the last knot, the end interval's mean rate. Passed by value to the projection's kernels (in
+// SweepDeskew): 1,040 bytes.
 struct SweepRotation {
   static constexpr int kIntervals = 16;
 
@@ -139,12 +140,22 @@ struct SweepRotation {
   }
 };
 
+// The translation of exp(time (v, w)) under a gyro's rotation: its series to the third order, v t +
+// (w x v) t^2 / 2 + (w x (w x v)) t^3 / 6, without translationAt()'s corrections of the coefficients (the
+// largest, at 3 rad/s half a sweep from the reference, a few micrometres; the translation's own turn at
+// the gyro's mean rate w, not at its rotation, is a sub-millimetre approximation already). Branch-free,
+// so that the CPU's loops over points and pixels vectorise.
+ELO_HOST_DEVICE inline Float3 gyroTranslationAt(const SweepVelocity& velocity, float time) {
+  const float time_squared = time * time;
+  return velocity.linear * time + velocity.turned_linear * (0.5f * time_squared) +
+         velocity.twice_turned_linear * ((1.0f / 6.0f) * time_squared * time);
+}
+
 // The point `p`, measured `time` seconds after the reference instant, in the reference frame, turned by
-// the gyro's rotation at its time and moved by the translation of the velocity's exponential (the
-// translation's own turn, w x v, at the velocity's rate: under a millimetre of difference over a sweep).
+// the gyro's rotation at its time and moved by the velocity's translation (gyroTranslationAt()).
 ELO_HOST_DEVICE inline Float3 deskewPoint(const SweepRotation& rotation, const SweepVelocity& velocity, float time,
                                           const Float3& p) {
-  return rotation.rotate(time, p) + translationAt(velocity, time, coefficientsAt(velocity, time));
+  return rotation.rotate(time, p) + gyroTranslationAt(velocity, time);
 }
 
 // Where each point's time comes from, and the sweep it belongs to.
@@ -241,12 +252,12 @@ ELO_HOST_DEVICE inline void redeskewPixel(const SweepVelocity& applied, const Sw
                     time, vertex, range, normal);
 }
 
-// A projected pixel deskewed again under `velocity`, turned by the gyro's `rotation` as in the projection:
-// only the translation changes, so the normal stays as it is.
-ELO_HOST_DEVICE inline void redeskewPixel(const SweepRotation& rotation, const SweepVelocity& velocity,
-                                          const Float3& measured, float time, Float3& vertex, float& range) {
-  vertex = deskewPoint(rotation, velocity, time, measured);
-  range = norm(vertex);
+// A projected pixel, turned by a gyro's rotation (deskewPoint() of a SweepRotation), deskewed again under
+// `velocity` after `applied`: the rotation stays, so its vertex moves by the change of the translation at
+// its time (computed for every pixel, so that the CPU's loop vectorises), and its normal stays as it is.
+ELO_HOST_DEVICE inline Float3 turnedPixelMoved(const SweepVelocity& applied, const SweepVelocity& velocity,
+                                               float time, const Float3& vertex) {
+  return vertex + (gyroTranslationAt(velocity, time) - gyroTranslationAt(applied, time));
 }
 
 }  // namespace elo

@@ -42,8 +42,9 @@ inline SweepRotation toSweepRotation(const GyroSweep& sweep) {
   for (int k = 0; k < SweepRotation::kIntervals; ++k) {
     SweepRotation::Interval& interval = rotation.interval[k];
     interval.start = static_cast<float>(sweep.first + k * step);
+    const Eigen::Matrix3f rotation = sweep.rotations[k].cast<float>();
     for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) interval.rotation[3 * row + col] = static_cast<float>(sweep.rotations[k](row, col));
+      for (int col = 0; col < 3; ++col) interval.rotation[3 * row + col] = rotation(row, col);
     }
     const Eigen::Vector3d mean_rate = logSO3(sweep.rotations[k].transpose() * sweep.rotations[k + 1]) / step;
     const Eigen::Vector3d rate_change = (sweep.rates[k + 1] - sweep.rates[k]) / (2.0 * step);

@@ -40,7 +40,7 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
   const SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
-  scan_rotation_ = deskew.rotation;
+  scan_turned_ = deskew.rotation.known != 0;
   size_t occupied = 0;
   scan_ground_built_ = false;
   arena_.execute([&] {
@@ -54,8 +54,8 @@ void CpuBackend::deskewScan(const Vector6d& velocity) {
   const SweepVelocity next = toSweepVelocity(velocity);
   scan_ground_built_ = false;
   arena_.execute([&] {
-    if (scan_rotation_.known) {
-      cpu::deskewScan(scan_rotation_, next, scan_);
+    if (scan_turned_) {
+      cpu::deskewTurnedScan(scan_velocity_, next, scan_);
     } else {
       cpu::deskewScan(scan_velocity_, next, scan_);
     }

@@ -85,13 +85,25 @@ void redeskewEachPixel(const SweepVelocity& applied, const SweepVelocity& veloci
   }
 }
 
-void redeskewEachPixel(const SweepRotation& rotation, const SweepVelocity& velocity, const PixelBlock& block) {
+// turnedPixelMoved() on every occupied pixel of a block, every pixel computed and then kept or not, so
+// that the loop vectorises (as redeskewLittleTurns()).
+void moveTurnedPixels(const SweepVelocity applied, const SweepVelocity velocity, const PixelBlock& block) {
+  const float* __restrict times = block.time;
+  Vec3f* __restrict vertices = block.vertex;
+  float* __restrict ranges = block.range;
   for (size_t pixel = block.begin; pixel < block.end; ++pixel) {
-    if (block.range[pixel] <= 0.0f) continue;
-    Float3 vertex;
-    redeskewPixel(rotation, velocity, toFloat3(block.measured[pixel]), block.time[pixel], vertex, block.range[pixel]);
-    block.vertex[pixel] = toVec3f(vertex);
+    const Float3 vertex = toFloat3(vertices[pixel]);
+    const Float3 moved = turnedPixelMoved(applied, velocity, times[pixel], vertex);
+    const bool occupied = ranges[pixel] > 0.0f;
+    vertices[pixel] = toVec3f(choose(occupied, moved, vertex));
+    ranges[pixel] = occupied ? norm(moved) : ranges[pixel];
   }
+}
+
+bool occupiedBlock(const PixelBlock& block) {
+  int occupied = 0;
+  for (size_t pixel = block.begin; pixel < block.end; ++pixel) occupied |= block.range[pixel] > 0.0f;
+  return occupied != 0;
 }
 
 template <typename Redeskew>
@@ -118,8 +130,10 @@ void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, Sca
   });
 }
 
-void deskewScan(const SweepRotation& rotation, const SweepVelocity& velocity, ScanImage& scan) {
-  forEachBlock(scan, [&](const PixelBlock& block) { redeskewEachPixel(rotation, velocity, block); });
+void deskewTurnedScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+  forEachBlock(scan, [&](const PixelBlock& block) {
+    if (occupiedBlock(block)) moveTurnedPixels(applied, velocity, block);
+  });
 }
 
 }  // namespace elo::cpu

@@ -1,5 +1,5 @@
 // Motion compensation of the projected scan on the GPU, in place: one thread per pixel, the per-pixel math
-// of the CPU backend (redeskewPixel(), deskew.hpp), turned at the velocity's rate or by the gyro's rotation.
+// of the CPU backend (redeskewPixel(), deskew.hpp; turnedPixelMoved() for a scan a gyro's rotation turned).
 #include "core/cuda/kernels.hpp"
 #include "core/cuda/launch.cuh"
 
@@ -14,10 +14,12 @@ __global__ void deskewPixels(DeviceScan scan, SweepVelocity applied, SweepVeloci
                 scan.normals[pixel]);
 }
 
-__global__ void deskewPixelsWithGyro(DeviceScan scan, SweepRotation rotation, SweepVelocity velocity) {
+__global__ void moveTurnedPixels(DeviceScan scan, SweepVelocity applied, SweepVelocity velocity) {
   const int pixel = globalThread();
   if (pixel >= scan.pixels() || !scan.occupied(pixel)) return;
-  redeskewPixel(rotation, velocity, scan.measured[pixel], scan.times[pixel], scan.vertices[pixel], scan.ranges[pixel]);
+  const Float3 moved = turnedPixelMoved(applied, velocity, scan.times[pixel], scan.vertices[pixel]);
+  scan.vertices[pixel] = moved;
+  scan.ranges[pixel] = norm(moved);
 }
 
 }  // namespace
@@ -28,10 +30,10 @@ void deskewScan(const DeviceScan& scan, const SweepVelocity& applied, const Swee
   checkLaunch("deskewPixels");
 }
 
-void deskewScan(const DeviceScan& scan, const SweepRotation& rotation, const SweepVelocity& velocity,
-                cudaStream_t stream) {
-  deskewPixelsWithGyro<<<blocksFor(scan.pixels()), kThreads, 0, stream>>>(scan, rotation, velocity);
-  checkLaunch("deskewPixelsWithGyro");
+void deskewTurnedScan(const DeviceScan& scan, const SweepVelocity& applied, const SweepVelocity& velocity,
+                      cudaStream_t stream) {
+  moveTurnedPixels<<<blocksFor(scan.pixels()), kThreads, 0, stream>>>(scan, applied, velocity);
+  checkLaunch("moveTurnedPixels");
 }
 
 }  // namespace elo::cuda

@@ -108,7 +108,9 @@ Eigen::Vector3d ImuTrack::rateAt(double time) const {
 std::string ImuTrack::sweepRotation(double reference, double from, double to, GyroSweep& sweep) const {
   constexpr int kKnots = GyroSweep::kIntervals + 1;
   // The last knot at `to` itself: the samples cover that much, and maybe not a rounding beyond.
-  const auto knot = [&](int k) { return k == GyroSweep::kIntervals ? to : from + k * (to - from) / GyroSweep::kIntervals; };
+  const auto knot = [&](int k) {
+    return k == GyroSweep::kIntervals ? to : from + k * (to - from) / GyroSweep::kIntervals;
+  };
   // Each knot's frame in the first knot's, interval after interval, then in the reference's.
   std::vector<Eigen::Matrix3d> from_first(kKnots, Eigen::Matrix3d::Identity());
   for (int k = 1; k < kKnots; ++k) {
