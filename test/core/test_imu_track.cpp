@@ -58,6 +58,11 @@ TEST(ImuTrack, AConstantRateTurnsTheLidarThroughTheMount) {
   EXPECT_LT(angleBetween(track.scanMotion(0.2, 0.3, 0.25, 0.35, 0.35).stamp_rotation,
                          Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
             1e-12);
+  // A stamp beyond the samples (which end at 1 s): the sweep's mean rate.
+  const GyroMotion late = track.scanMotion(0.8, 0.9, 0.85, 0.95, 1.2);
+  ASSERT_TRUE(late.known) << late.fallback;
+  EXPECT_LT(angleBetween(late.stamp_rotation, Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
+            1e-12);
 }
 
 // A rate rising linearly is integrated exactly between and within samples: 0.5 a t^2 about x.

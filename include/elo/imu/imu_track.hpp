@@ -64,7 +64,8 @@ class ImuTrack {
   // it cannot be, or empty, as rotation() does.
   std::string sweepRotation(double reference, double from, double to, GyroSweep& sweep) const;
   // rotation() between the reference instants of two scans, the mean rate and sweepRotation() over the
-  // later one's sweep, and its rotation between its reference instant and its `stamp`.
+  // later one's sweep, and its rotation between its reference instant and its `stamp` (at the mean rate
+  // where the samples do not reach the stamp).
   GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to,
                         double stamp) const;
   // Moves the gyro's bias estimate towards what makes its rotation `gyro` (from rotation()) over `dt`

@@ -140,12 +140,15 @@ GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, dou
   motion.fallback = rotation(previous_reference, reference, motion.rotation);
   if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
   if (motion.fallback.empty()) motion.fallback = sweepRotation(reference, sweep_from, sweep_to, motion.sweep);
-  if (motion.fallback.empty()) {
-    motion.fallback = rotation(std::min(stamp, reference), std::max(stamp, reference), motion.stamp_rotation);
-    if (stamp < reference) motion.stamp_rotation.transposeInPlace();
-  }
   motion.known = motion.fallback.empty();
-  if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
+  if (!motion.known) return motion;
+  motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
+  // A stamp beyond the samples (a driver's stamp past the sweep) turns at the sweep's mean rate.
+  if (rotation(std::min(stamp, reference), std::max(stamp, reference), motion.stamp_rotation).empty()) {
+    if (stamp < reference) motion.stamp_rotation.transposeInPlace();
+  } else {
+    motion.stamp_rotation = rotationOf((stamp - reference) * motion.sweep_rate);
+  }
   return motion;
 }
 
