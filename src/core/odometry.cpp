@@ -150,7 +150,8 @@ GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResu
   const double reference = stamp + times.reference;
   const double half_sweep = 0.5 / config_.sensor.rotation_rate_hz;
   const double previous_reference = started_ ? last_stamp_ + last_reference_ : reference;
-  GyroMotion gyro = imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep);
+  GyroMotion gyro =
+      imu_.scanMotion(previous_reference, reference, reference - half_sweep, reference + half_sweep, stamp);
   inertial_interval_known_ = gyro.known && preintegrateInterval(previous_reference, reference);
   if (!gyro.fallback.empty()) ++imu_fallbacks_[gyro.fallback];
   result.imu_fallback = gyro.fallback;
@@ -187,11 +188,13 @@ Vector6d Odometry::withGyroRate(Vector6d velocity) const {
 
 size_t Odometry::projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
                                  FrameResult& result) {
-  const size_t occupied = backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
-  if (occupied >= minOccupiedPixels() || velocity.isZero()) return occupied;
+  // With the gyro, each point turned by its rotation at the point's own time (the velocity's rate serves
+  // the translation's own turn only).
+  const size_t occupied = backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference, gyro_.sweep});
+  if (occupied >= minOccupiedPixels() || (velocity.isZero() && !gyro_.sweep.known())) return occupied;
   velocity.setZero();
   result.projected_without_deskew = true;
-  return backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference});
+  return backend_->projectScan(cloud, stamp, {times.source, velocity, times.reference, {}});
 }
 
 Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& reference_delta, double dt,
@@ -199,7 +202,10 @@ Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& referenc
                                                FrameResult& result) {
   // Under the velocity the points were moved with, the sensor at the stamp (time 0, `reference` seconds
   // before the reference instant) is exp(-reference * velocity) in the reference frame.
-  const Eigen::Isometry3d stamp_in_reference = expSE3(-times.reference * deskewed_under);
+  Eigen::Isometry3d stamp_in_reference = expSE3(-times.reference * deskewed_under);
+  // With a gyro, the turn it measured between the two instants: the velocity's rate is its mean over the
+  // sweep, which the stamp at one end of a sweep swung at a changing rate would miss by up to a degree.
+  if (gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   // The first scan of a start had no velocity to place its stamp in its sweep; registered against it as
   // measured (bent alike), this scan measured the motion between like instants of the two sweeps.
   if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
@@ -315,7 +321,7 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   gyro_ = gyroMotion(cloud.stamp, times, result);
   auto stage_start = Clock::now();
   // Deskewed under the velocity last registered: the first scans (none yet) as they were measured. With an
-  // IMU, turning at the gyro's rate over the sweep.
+  // IMU, turned by the gyro's rotation through the sweep.
   Vector6d sweep_velocity = withGyroRate(started_ ? sweepVelocityBeforeRegistration() : Vector6d::Zero());
   const size_t occupied = projectDeskewed(cloud, relative_stamp, times, sweep_velocity, result);
   result.times.projection = millisecondsSince(stage_start);

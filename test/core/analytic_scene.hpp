@@ -185,6 +185,38 @@ inline ScanWithTruth sweepScene(const Scene& scene, const SensorConfig& sensor,
   return scan;
 }
 
+// A sensor turning about a fixed `axis` (unit, its frame), the angle `angle(t)` at `t` seconds from an
+// instant, while it slides at `linear` m/s in that instant's frame: the motion of a handheld sensor swung
+// at a rate that changes within a sweep, which a constant twist cannot follow and a gyro can.
+template <typename Angle>
+struct Swing {
+  Eigen::Vector3d axis;
+  Angle angle;
+  Eigen::Vector3d linear;
+
+  // The sensor's frame at `t` in its frame at the instant.
+  Eigen::Isometry3d at(double t) const {
+    Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+    frame.linear() = Eigen::AngleAxisd(angle(t), axis).toRotationMatrix();
+    frame.translation() = linear * t;
+    return frame;
+  }
+};
+
+// A sweep of a sensor swung by `swing` about its reference instant, at `world_from_reference` then:
+// step k fires from world_from_reference * swing.at(t_k), t_k = firingTime(k), which every point
+// carries in `time`.
+template <typename Angle>
+ScanWithTruth swungSweepScene(const Scene& scene, const SensorConfig& sensor,
+                              const Eigen::Isometry3d& world_from_reference, const Swing<Angle>& swing,
+                              double stamp = 0.0) {
+  ScanWithTruth scan = scanSceneFrom(
+      scene, sensor, [&](int step) { return world_from_reference * swing.at(firingTime(sensor, step)); }, stamp, 0.0,
+      1);
+  for (int step : scan.step) scan.cloud.time.push_back(static_cast<float>(firingTime(sensor, step)));
+  return scan;
+}
+
 // A street: ground, facades on both sides with gaps, a wall across the end and parked boxes, so that
 // all six degrees of freedom are constrained.
 inline Scene streetScene() {

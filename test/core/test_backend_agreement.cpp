@@ -466,6 +466,104 @@ TEST(BackendAgreement, PosesAgreeWithTheImu) {
   }
 }
 
+// A sensor swung about a tilted axis at 180 deg/s at mid-sweep, the rate rising by half of that within
+// the sweep, while it slides at 1.4 m/s (test::Swing); the LiDAR's rotation through the sweep by a 200 Hz
+// gyro, as the odometry deskews it (docs/imu.md).
+double swingAngle(double time) { return M_PI * time + 0.25 * M_PI / 0.1 * time * time; }
+
+GyroSweep gyroOfSwing(const Eigen::Vector3d& axis) {
+  ImuTrack track{ImuConfig()};
+  for (int i = -40; i <= 40; ++i) {
+    ImuSample sample;
+    sample.stamp = 0.005 * i;
+    sample.angular_velocity = axis * (M_PI + 0.5 * M_PI / 0.1 * sample.stamp);
+    track.add(sample);
+  }
+  GyroSweep sweep;
+  EXPECT_EQ(track.sweepRotation(0.0, -0.05, 0.05, sweep), "");
+  return sweep;
+}
+
+// Each point turned by the gyro's rotation at its own time (the shared SweepRotation), in the projection
+// and again in place under a new translation, with field and azimuth times.
+TEST(BackendAgreement, DeskewWithTheGyroMovesThePointsAlike) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  const test::Swing<double (*)(double)> swing{Eigen::Vector3d(0.1, -0.2, 1.0).normalized(), &swingAngle,
+                                              Eigen::Vector3d(1.4, 0.2, 0.0)};
+  PointCloud cloud = test::swungSweepScene(test::streetScene(), config.sensor, pose(-3, 0.5, 0, 0, 0, 10), swing).cloud;
+  for (size_t i = 0; i < cloud.size(); i += 101) cloud.time[i] = i % 2 ? NAN : 5.0f;
+  const GyroSweep gyro = gyroOfSwing(swing.axis);
+  ASSERT_TRUE(gyro.known());
+  Vector6d velocity = Vector6d::Zero();
+  velocity.head<3>() = swing.linear;
+  velocity.tail<3>() = M_PI * swing.axis;
+  for (const TimeSource source : {TimeSource::field, TimeSource::azimuth}) {
+    SCOPED_TRACE(source == TimeSource::field ? "field" : "azimuth");
+    Backends backends(config);
+    for (Backend* backend : {backends.cpu.get(), backends.cuda.get()}) {
+      backend->projectScan(cloud, 0.0f, {source, 0.5 * velocity, 0.0, gyro});
+      backend->segmentGround();
+      backend->estimateNormals();
+    }
+    expectSameProjection(backends.cpu->scan(), backends.cuda->scan());
+    EXPECT_EQ(backends.cpu->scan().time, backends.cuda->scan().time);
+    for (Backend* backend : {backends.cpu.get(), backends.cuda.get()}) {
+      backend->deskewScan(velocity);
+      backend->buildGroundMap();
+    }
+    expectSameProjection(backends.cpu->scan(), backends.cuda->scan());
+    expectAgreeingNormals(backends.cpu->scan().image, backends.cuda->scan().image);
+    expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
+  }
+}
+
+// A drive of sweeps taken while the sensor yaws at 1.5 rad/s and 1 rad/s more or less, the rate swinging
+// within every sweep (a period of 0.4 s), while it slides along the street at 8 m/s: the gyro turns
+// each point by its own rotation on both backends, frame-to-model and frame-to-frame.
+TEST(BackendAgreement, PosesAgreeWithTheGyroTurningWithinEachSweep) {
+  ELO_REQUIRE_CUDA();
+  constexpr double kSwingPeriod = 0.4;
+  const auto angle = [](double t) {
+    return 1.5 * t - kSwingPeriod / (2.0 * M_PI) * std::cos(2.0 * M_PI * t / kSwingPeriod);
+  };
+  const auto rate = [](double t) { return 1.5 + std::sin(2.0 * M_PI * t / kSwingPeriod); };
+  for (const RegistrationMode mode : {RegistrationMode::frame_to_model, RegistrationMode::frame_to_frame}) {
+    SCOPED_TRACE(mode == RegistrationMode::frame_to_model ? "frame-to-model" : "frame-to-frame");
+    Config config;
+    config.imu.enabled = true;
+    config.model.mode = mode;
+    config.runtime.threads = 2;
+    Odometry cpu(config);
+    config.runtime.backend = BackendKind::cuda;
+    Odometry cuda(config);
+    for (int sample = -40; sample <= 200; ++sample) {
+      ImuSample gyro;
+      gyro.stamp = 0.005 * sample;
+      gyro.angular_velocity = Eigen::Vector3d(0.0, 0.0, rate(gyro.stamp));
+      cpu.addImu(gyro);
+      cuda.addImu(gyro);
+    }
+    for (int frame = 0; frame < 8; ++frame) {
+      const double stamp = 0.1 * frame;
+      const auto turned = [&](double t) { return angle(stamp + t) - angle(stamp); };
+      const test::Swing<decltype(turned)> swing{Eigen::Vector3d::UnitZ(), turned,
+                                                Eigen::AngleAxisd(-angle(stamp), Eigen::Vector3d::UnitZ()) *
+                                                    Eigen::Vector3d(8.0, 0.0, 0.0)};
+      const Eigen::Isometry3d reference = pose(-25.0 + 8.0 * stamp, 0, 0, 0, 0, angle(stamp) * 180.0 / M_PI);
+      const PointCloud cloud =
+          test::swungSweepScene(test::streetScene(), config.sensor, reference, swing, stamp).cloud;
+      const FrameResult a = cpu.process(cloud);
+      const FrameResult b = cuda.process(cloud);
+      ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+      EXPECT_EQ(a.imu_fallback, "");
+      EXPECT_EQ(b.imu_fallback, "");
+      EXPECT_EQ(a.deskew_rounds, b.deskew_rounds);
+      expectAgreeingPoses(a.pose, b.pose, frame);
+    }
+  }
+}
+
 TEST(BackendAgreement, RealScansAgreeStageByStageAndInPose) {
   ELO_REQUIRE_CUDA();
   if (!std::filesystem::is_directory(kRealScans)) {

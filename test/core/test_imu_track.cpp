@@ -49,9 +49,20 @@ TEST(ImuTrack, AConstantRateTurnsTheLidarThroughTheMount) {
   ASSERT_EQ(track.rotation(0.1234, 0.6234, rotation), "");
   const Eigen::Matrix3d expected = Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   EXPECT_LT(angleBetween(rotation, expected), 1e-12);
-  const GyroMotion motion = track.scanMotion(0.2, 0.3, 0.25, 0.35);
+  const GyroMotion motion = track.scanMotion(0.2, 0.3, 0.25, 0.35, 0.25);
   ASSERT_TRUE(motion.known) << motion.fallback;
   EXPECT_LT((motion.sweep_rate - Eigen::Vector3d(0.0, 0.0, -1.0)).norm(), 1e-12);
+  // The stamp, at the sweep's start, 0.05 s before the reference: turned 0.05 rad anticlockwise from it.
+  EXPECT_LT(angleBetween(motion.stamp_rotation, Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
+            1e-12);
+  EXPECT_LT(angleBetween(track.scanMotion(0.2, 0.3, 0.25, 0.35, 0.35).stamp_rotation,
+                         Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
+            1e-12);
+  // A stamp beyond the samples (which end at 1 s): the sweep's mean rate.
+  const GyroMotion late = track.scanMotion(0.8, 0.9, 0.85, 0.95, 1.2);
+  ASSERT_TRUE(late.known) << late.fallback;
+  EXPECT_LT(angleBetween(late.stamp_rotation, Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
+            1e-12);
 }
 
 // A rate rising linearly is integrated exactly between and within samples: 0.5 a t^2 about x.
@@ -84,7 +95,7 @@ TEST(ImuTrack, AnIntervalTheSamplesDoNotCoverOrAGapSaysWhy) {
   EXPECT_EQ(track.rotation(-0.1, 0.2, rotation), imu_issue::kNotCovered);
   EXPECT_EQ(track.rotation(0.4, 0.6, rotation), imu_issue::kGap);
   EXPECT_EQ(track.rotation(0.6, 0.9, rotation), "");
-  EXPECT_EQ(track.scanMotion(0.4, 0.6, 0.55, 0.65).fallback, imu_issue::kGap);
+  EXPECT_EQ(track.scanMotion(0.4, 0.6, 0.55, 0.65, 0.6).fallback, imu_issue::kGap);
 }
 
 TEST(ImuTrack, BadSamplesAreDroppedAndCounted) {

@@ -1,5 +1,6 @@
 // The IMU's samples the odometry holds, and what it reads of them (docs/imu.md): the LiDAR's rotation
-// between two instants by the integrated gyro, and its mean turn rate over a sweep, in the LiDAR's frame.
+// between two instants by the integrated gyro, its mean turn rate over a sweep and its rotation through
+// the sweep, in the LiDAR's frame.
 // A rigid mount turns both sensors alike, so only the mount's rotation matters here, not its offset.
 #pragma once
 
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "elo/config.hpp"
+#include "elo/imu/gyro_sweep.hpp"
 
 namespace elo {
 
@@ -47,12 +49,16 @@ struct ImuStatus {
 };
 
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference
-// instants) and its mean rate over the scan's sweep, in the LiDAR's frame. Known when the samples cover
-// both; else `fallback` says why (empty without imu.enabled).
+// instants), its mean rate over the scan's sweep, its rotation through the sweep and at the scan's stamp,
+// in the LiDAR's frame.
+// Known when the samples cover both; else `fallback` says why (empty without imu.enabled).
 struct GyroMotion {
   bool known = false;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d sweep_rate = Eigen::Vector3d::Zero();  // rad/s
+  GyroSweep sweep;
+  // The frame at the scan's stamp in the frame at its reference instant (the reported pose's turn).
+  Eigen::Matrix3d stamp_rotation = Eigen::Matrix3d::Identity();
   std::string fallback;
 };
 
@@ -85,8 +91,16 @@ class ImuTrack {
   // cannot be, or empty: samples must lie at or before `from` and at or after `to`, none of them further
   // apart than two periods at imu.min_rate_hz.
   std::string rotation(double from, double to, Eigen::Matrix3d& rotation) const;
-  // rotation() between the reference instants of two scans, and meanRate() over the later one's sweep.
-  GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to) const;
+  // The LiDAR's rotation through [from, to] (a sweep, s on the scans' clock) in its frame at `reference`
+  // (within it), and its rate, at the knots of `sweep` (GyroSweep::kIntervals + 1, evenly spread, their
+  // times from `reference`): rotation() between the knots, the rate linear between samples. Returns why
+  // it cannot be, or empty, as rotation() does.
+  std::string sweepRotation(double reference, double from, double to, GyroSweep& sweep) const;
+  // rotation() between the reference instants of two scans, the mean rate and sweepRotation() over the
+  // later one's sweep, and its rotation between its reference instant and its `stamp` (at the mean rate
+  // where the samples do not reach the stamp).
+  GyroMotion scanMotion(double previous_reference, double reference, double sweep_from, double sweep_to,
+                        double stamp) const;
   // The gyro and the accelerometers integrated from `from` to `to` (the scans' clock), their rate and
   // specific force linear between samples, into `motion`; returns why it cannot be, as rotation() does.
   std::string preintegrate(double from, double to, Preintegration& motion) const;
@@ -108,6 +122,9 @@ class ImuTrack {
   Eigen::Vector3d biasEstimate() const { return gyro_bias_ + learnt_bias_; }
 
  private:
+  // The gyro's rate at `time` (within the samples), linear between samples, its bias removed, LiDAR axes.
+  Eigen::Vector3d rateAt(double time) const;
+
   double max_gap_;
   double gyro_limit_;  // rad/s
   double accel_limit_;  // m/s^2

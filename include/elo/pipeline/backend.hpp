@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "elo/config.hpp"
+#include "elo/imu/gyro_sweep.hpp"
 #include "elo/se3.hpp"
 #include "elo/types.hpp"
 
@@ -37,11 +38,14 @@ struct NormalEquations {
 // How the projection deskews a scan (docs/deskew.md): where its points' times come from (deskew.time_source,
 // or `none` for a cloud without usable times: instantaneous) and the sensor's velocity over the sweep, a
 // twist per second (translation, rotation) in the scan's frame at its reference instant, and that instant
-// in the cloud's per-point times (`field`: CloudTimes::reference, the middle of the sweep).
+// in the cloud's per-point times (`field`: CloudTimes::reference, the middle of the sweep). With a gyro
+// (docs/imu.md), `gyro` turns each point by the rotation at its own time instead of the velocity's rate,
+// in the projection and in every deskew after it (deskewScan()), which change only the translation.
 struct SweepMotion {
   TimeSource times = TimeSource::none;
   Vector6d velocity = Vector6d::Zero();
   double reference = 0.0;
+  GyroSweep gyro = {};
 };
 
 // A device backend queues the work of a stage call and returns; a call whose result the host needs (the
@@ -58,8 +62,9 @@ class Backend {
   // cloud whose times are missing or not one per point is taken as `none`.
   virtual size_t projectScan(const PointCloud& cloud, float stamp, const SweepMotion& motion = {}) = 0;
   // Deskews the projected scan again under `velocity` (as SweepMotion::velocity): every vertex from its
-  // measured point and time, every normal turned with it. Pixels, labels and the registration pixels
-  // stay; the ground map must be built again (buildGroundMap()). Nothing to do for an instantaneous scan.
+  // measured point and time, every normal turned with it (under the projection's gyro, SweepMotion::gyro,
+  // the turn stays and so do the normals). Pixels, labels and the registration pixels stay; the ground
+  // map must be built again (buildGroundMap()). Nothing to do for an instantaneous scan.
   virtual void deskewScan(const Vector6d& velocity) = 0;
   // Sec. III-C.1: labels every occupied pixel ground or non-ground.
   virtual void segmentGround() = 0;

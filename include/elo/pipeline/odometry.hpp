@@ -198,8 +198,10 @@ class Odometry {
   // The velocity a scan is deskewed under before it is registered: the last registered (the motion
   // prior's), or after a refusal the one accepted last; zero at a start and without a motion prior.
   Vector6d sweepVelocityBeforeRegistration() const;
-  // Projects the cloud deskewed under `velocity`; when that fills too few pixels (a wrong velocity moves
-  // the points out of the image), projects it again as measured, saying so in `result`: a scan is then
+  // Projects the cloud deskewed under `velocity`, turned by the gyro's rotation through the sweep when it
+  // is known; when that fills too few pixels (a wrong velocity moves the points out of the image),
+  // projects it again as measured (deskewed again, if at all, at the velocity's rate), saying so in
+  // `result`: a scan is then
   // skipped for what it is, never for the odometry's own velocity. Returns the occupied pixels.
   size_t projectDeskewed(const PointCloud& cloud, float stamp, const CloudTimes& times, Vector6d& velocity,
                          FrameResult& result);

@@ -93,6 +93,71 @@ ELO_HOST_DEVICE inline Float3 deskewDirection(const SweepVelocity& velocity, flo
   return rotateAt(velocity, time, coefficientsAt(velocity, time), n);
 }
 
+// The sensor's rotation over a sweep by the gyro (GyroSweep, include/elo/imu/gyro_sweep.hpp), in float for
+// the kernels: each point turned by the rotation at its own time, where a SweepVelocity turns it at one
+// constant rate. kIntervals intervals of `step` seconds from `first` (s from the reference instant); over
+// interval k, `within` seconds after its start, the frame is rotation_k exp(turn), turn = mean_rate_k within
+// + rate_change_k within (within - step): rotation_{k+1} at its end, the rate linear in time between the
+// gyro's rates at the two knots (exact for a rate linear in time about a fixed axis). Before the first and
+// after the last knot, the end interval's mean rate. Passed by value to the projection's kernels (in
+// SweepDeskew): 1,040 bytes.
+struct SweepRotation {
+  static constexpr int kIntervals = 16;
+
+  struct Interval {
+    float start;        // s from the reference instant
+    float rotation[9];  // the frame at `start` in the reference frame, row-major
+    Float3 mean_rate;   // rad/s: log(rotation_k^T rotation_{k+1}) / step
+    Float3 rate_change;  // rad/s^2: (rate_{k+1} - rate_k) / (2 step)
+  };
+
+  int known;  // 0: no gyro; the sweep turns at the velocity's rate
+  float first;
+  float step;
+  float intervals_per_second;
+  Interval interval[kIntervals];
+
+  // The interval a point `time` seconds from the reference falls in; the end ones beyond the knots.
+  ELO_HOST_DEVICE int intervalOf(float time) const {
+    const float position = (time - first) * intervals_per_second;
+    if (!(position >= 1.0f)) return 0;
+    if (position >= static_cast<float>(kIntervals - 1)) return kIntervals - 1;
+    return static_cast<int>(position);
+  }
+
+  // `p`, measured `time` seconds from the reference instant, turned into the reference frame.
+  ELO_HOST_DEVICE Float3 rotate(float time, const Float3& p) const {
+    const Interval& at = interval[intervalOf(time)];
+    const float within = time - at.start;
+    const float bent = within < 0.0f ? 0.0f : (within > step ? step : within);  // a constant rate beyond the knots
+    const Float3 turn = at.mean_rate * within + at.rate_change * (bent * (bent - step));
+    const TwistCoefficients k = TwistCoefficients::ofSquaredAngle(squaredNorm(turn));
+    const Float3 once = cross(turn, p);
+    const Float3 turned = p + once * k.a + cross(turn, once) * k.b;
+    const float* r = at.rotation;
+    return {r[0] * turned.x + r[1] * turned.y + r[2] * turned.z, r[3] * turned.x + r[4] * turned.y + r[5] * turned.z,
+            r[6] * turned.x + r[7] * turned.y + r[8] * turned.z};
+  }
+};
+
+// The translation of exp(time (v, w)) under a gyro's rotation: its series to the third order, v t +
+// (w x v) t^2 / 2 + (w x (w x v)) t^3 / 6, without translationAt()'s corrections of the coefficients (the
+// largest, at 3 rad/s half a sweep from the reference, a few micrometres; the translation's own turn at
+// the gyro's mean rate w, not at its rotation, is a sub-millimetre approximation already). Branch-free,
+// so that the CPU's loops over points and pixels vectorise.
+ELO_HOST_DEVICE inline Float3 gyroTranslationAt(const SweepVelocity& velocity, float time) {
+  const float time_squared = time * time;
+  return velocity.linear * time + velocity.turned_linear * (0.5f * time_squared) +
+         velocity.twice_turned_linear * ((1.0f / 6.0f) * time_squared * time);
+}
+
+// The point `p`, measured `time` seconds after the reference instant, in the reference frame, turned by
+// the gyro's rotation at its time and moved by the velocity's translation (gyroTranslationAt()).
+ELO_HOST_DEVICE inline Float3 deskewPoint(const SweepRotation& rotation, const SweepVelocity& velocity, float time,
+                                          const Float3& p) {
+  return rotation.rotate(time, p) + gyroTranslationAt(velocity, time);
+}
+
 // Where each point's time comes from, and the sweep it belongs to.
 struct SweepTiming {
   TimeSource source;
@@ -143,16 +208,22 @@ struct SweepTiming {
 };
 
 // The deskew of one scan's projection: how its points are timed, the cloud's per-point times (null unless
-// the source is `field`) and the velocity the points are moved under.
+// the source is `field`), the velocity the points are moved under and, with a gyro, the rotation that
+// turns them instead of the velocity's rate.
 struct SweepDeskew {
   SweepTiming timing;
   const float* times;
   SweepVelocity velocity;
+  SweepRotation rotation = {};
 
   // Cloud point `index`, as `measured`, moved to the reference instant; false when it has no usable time.
   ELO_HOST_DEVICE bool apply(int index, const Float3& measured, float& time, Float3& deskewed) const {
     if (!timing.pointTime(times, index, measured, time)) return false;
-    deskewed = velocity.isZero() ? measured : deskewPoint(velocity, time, measured);
+    if (rotation.known) {
+      deskewed = deskewPoint(rotation, velocity, time, measured);
+    } else {
+      deskewed = velocity.isZero() ? measured : deskewPoint(velocity, time, measured);
+    }
     return true;
   }
 };
@@ -179,6 +250,14 @@ ELO_HOST_DEVICE inline void redeskewPixel(const SweepVelocity& applied, const Sw
                                           Float3& normal) {
   redeskewPixelWith(applied, velocity, coefficientsAt(velocity, time), coefficientsAt(applied, -time), measured,
                     time, vertex, range, normal);
+}
+
+// A projected pixel, turned by a gyro's rotation (deskewPoint() of a SweepRotation), deskewed again under
+// `velocity` after `applied`: the rotation stays, so its vertex moves by the change of the translation at
+// its time (computed for every pixel, so that the CPU's loop vectorises), and its normal stays as it is.
+ELO_HOST_DEVICE inline Float3 turnedPixelMoved(const SweepVelocity& applied, const SweepVelocity& velocity,
+                                               float time, const Float3& vertex) {
+  return vertex + (gyroTranslationAt(velocity, time) - gyroTranslationAt(applied, time));
 }
 
 }  // namespace elo

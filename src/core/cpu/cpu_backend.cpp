@@ -40,6 +40,7 @@ size_t CpuBackend::projectScan(const PointCloud& cloud, float stamp, const Sweep
   const SweepDeskew deskew = sweepDeskew(config_.sensor, cloud, motion);
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
+  scan_turned_ = deskew.rotation.known != 0;
   size_t occupied = 0;
   scan_ground_built_ = false;
   arena_.execute([&] {
@@ -52,7 +53,13 @@ void CpuBackend::deskewScan(const Vector6d& velocity) {
   if (scan_times_ == TimeSource::none) return;
   const SweepVelocity next = toSweepVelocity(velocity);
   scan_ground_built_ = false;
-  arena_.execute([&] { cpu::deskewScan(scan_velocity_, next, scan_); });
+  arena_.execute([&] {
+    if (scan_turned_) {
+      cpu::deskewTurnedScan(scan_velocity_, next, scan_);
+    } else {
+      cpu::deskewScan(scan_velocity_, next, scan_);
+    }
+  });
   scan_velocity_ = next;
 }
 

@@ -43,9 +43,11 @@ class CpuBackend final : public Backend {
   tbb::task_arena arena_;
 
   ScanImage scan_;
-  // The scan's deskew: whether its points have times, and the velocity its vertices are deskewed under.
+  // The scan's deskew: whether its points have times, the velocity its vertices are deskewed under and
+  // whether a gyro's rotation turned them (it then stays through every deskew after the projection).
   TimeSource scan_times_ = TimeSource::none;
   SweepVelocity scan_velocity_{};
+  bool scan_turned_ = false;
   std::vector<int32_t> registration_pixels_;  // non-ground pixels with a normal
   std::vector<int32_t> ground_pixels_;  // as labelled; the ground map is built (and rebuilt) from them
   // Each ground map its own scratch: its arrays then keep about their size from frame to frame, and a

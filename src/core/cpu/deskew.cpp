@@ -85,15 +85,41 @@ void redeskewEachPixel(const SweepVelocity& applied, const SweepVelocity& veloci
   }
 }
 
-}  // namespace
+// turnedPixelMoved() on every occupied pixel of a block, every pixel computed and then kept or not, so
+// that the loop vectorises (as redeskewLittleTurns()).
+void moveTurnedPixels(const SweepVelocity applied, const SweepVelocity velocity, const PixelBlock& block) {
+  const float* __restrict times = block.time;
+  Vec3f* __restrict vertices = block.vertex;
+  float* __restrict ranges = block.range;
+  for (size_t pixel = block.begin; pixel < block.end; ++pixel) {
+    const Float3 vertex = toFloat3(vertices[pixel]);
+    const Float3 moved = turnedPixelMoved(applied, velocity, times[pixel], vertex);
+    const bool occupied = ranges[pixel] > 0.0f;
+    vertices[pixel] = toVec3f(choose(occupied, moved, vertex));
+    ranges[pixel] = occupied ? norm(moved) : ranges[pixel];
+  }
+}
 
-void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+bool occupiedBlock(const PixelBlock& block) {
+  int occupied = 0;
+  for (size_t pixel = block.begin; pixel < block.end; ++pixel) occupied |= block.range[pixel] > 0.0f;
+  return occupied != 0;
+}
+
+template <typename Redeskew>
+void forEachBlock(ScanImage& scan, const Redeskew& redeskew) {
   SphericalImage& image = scan.image;
   const size_t pixels = image.pixelCount();
   parallelFor((pixels + kBlock - 1) / kBlock, [&](size_t index) {
-    const PixelBlock block{scan.measured.data(), scan.time.data(),   image.vertex.data(),
-                           image.range.data(),   image.normal.data(), index * kBlock,
-                           std::min(pixels, (index + 1) * kBlock)};
+    redeskew(PixelBlock{scan.measured.data(), scan.time.data(), image.vertex.data(), image.range.data(),
+                        image.normal.data(), index * kBlock, std::min(pixels, (index + 1) * kBlock)});
+  });
+}
+
+}  // namespace
+
+void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+  forEachBlock(scan, [&](const PixelBlock& block) {
     const BlockContents contents = contentsOf(applied, velocity, block);
     if (!contents.occupied) return;
     if (contents.turns_little) {
@@ -101,6 +127,12 @@ void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, Sca
     } else {
       redeskewEachPixel(applied, velocity, block);
     }
+  });
+}
+
+void deskewTurnedScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan) {
+  forEachBlock(scan, [&](const PixelBlock& block) {
+    if (occupiedBlock(block)) moveTurnedPixels(applied, velocity, block);
   });
 }
 

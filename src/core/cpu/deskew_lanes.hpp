@@ -80,10 +80,32 @@ struct PlacedLanes {
   __m256 z;
 };
 
+// The usable points of a group (`group.usable`) as measured, at their times, turned by the gyro's
+// rotation and moved: deskewPoint() of a SweepRotation, point by point. The others keep their measured
+// point (they are not offered).
+inline void placeTurnedLanes(const SweepDeskew& deskew, const float (&measured)[3][kPixelLanes],
+                             const float (&time)[kPixelLanes], size_t first, ScanPoint* placed, PlacedLanes& group) {
+  float vertex[3][kPixelLanes];
+  for (int lane = 0; lane < kPixelLanes; ++lane) {
+    ScanPoint& point = placed[first + lane];
+    point.measured = {measured[0][lane], measured[1][lane], measured[2][lane]};
+    point.time = time[lane];
+    point.vertex = (group.usable & (1u << lane)) ? deskewPoint(deskew.rotation, deskew.velocity, time[lane], point.measured)
+                                                 : point.measured;
+    vertex[0][lane] = point.vertex.x;
+    vertex[1][lane] = point.vertex.y;
+    vertex[2][lane] = point.vertex.z;
+  }
+  group.x = _mm256_loadu_ps(vertex[0]);
+  group.y = _mm256_loadu_ps(vertex[1]);
+  group.z = _mm256_loadu_ps(vertex[2]);
+}
+
 // scanPointVertex() of the points [first, first + kPixelLanes) of `xyz` (x, y, z after one another),
 // each one's measured point, time and vertex into `placed`, bit for bit. False, with the group's vertices
 // not computed, where a point that has a time turns by more than the short series' bound: the caller
-// places that group point by point.
+// places that group point by point. A sweep a gyro's rotation turns (SweepRotation) has its times found
+// in lanes and each point turned by the shared function.
 inline bool placeLanes(const ElevationCorrection& correction, const SweepDeskew& deskew, const float* xyz,
                        size_t first, ScanPoint* placed, PlacedLanes& group) {
   __m256 raw_x, raw_y, raw_z;
@@ -112,6 +134,10 @@ inline bool placeLanes(const ElevationCorrection& correction, const SweepDeskew&
     }
   }
   group.usable = finite & timed;
+  if (deskew.rotation.known) {
+    placeTurnedLanes(deskew, measured, time, first, placed, group);
+    return true;
+  }
   const SweepVelocity& velocity = deskew.velocity;
   for (int lane = 0; lane < kPixelLanes; ++lane) {
     const bool turns_little = velocity.angular_squared * time[lane] * time[lane] < TwistCoefficients::kSmallSquaredAngle;

@@ -29,6 +29,10 @@ size_t projectCloud(const PointCloud& cloud, const SensorConfig& sensor, const S
 
 // deskew.cpp: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
 void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
+// deskew.cpp: every occupied pixel of a scan turned by a gyro's rotation (SweepRotation) deskewed again,
+// under `velocity` after `applied`: moved by the change of translation (turnedPixelMoved()); the normals
+// stay.
+void deskewTurnedScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
 
 // ground_segmentation.cpp: labels occupied pixels ground or non-ground, column by column.
 void segmentGround(const GroundConfig& config, ScanImage& scan);

@@ -332,6 +332,7 @@ size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const Swee
   deskew.times = with_times ? buffers.times.data() : nullptr;
   scan_times_ = deskew.timing.source;
   scan_velocity_ = deskew.velocity;
+  scan_turned_ = deskew.rotation.known != 0;
   const UploadedCloud uploaded{buffers.points.data(), buffers.has_rings ? buffers.rings.data() : nullptr,
                                static_cast<int>(buffers.count)};
   cuda::projectScan(uploaded, spherical_, correction_, deskew, ring_rows_device_.data(),
@@ -350,7 +351,11 @@ size_t CudaBackend::projectScan(const PointCloud& cloud, float stamp, const Swee
 void CudaBackend::deskewScan(const Vector6d& velocity) {
   if (scan_times_ == TimeSource::none) return;
   const SweepVelocity next = toSweepVelocity(velocity);
-  cuda::deskewScan(deviceScan(), scan_velocity_, next, stream_.get());
+  if (scan_turned_) {
+    cuda::deskewTurnedScan(deviceScan(), scan_velocity_, next, stream_.get());
+  } else {
+    cuda::deskewScan(deviceScan(), scan_velocity_, next, stream_.get());
+  }
   scan_velocity_ = next;
   scan_view_current_ = false;
 }

@@ -198,9 +198,11 @@ class CudaBackend final : public Backend {
   DeviceArray<PixelLabel> labels_;
   DeviceArray<Float3> measured_;
   DeviceArray<float> pixel_times_;
-  // The scan's deskew: whether its points have times, and the velocity its vertices are deskewed under.
+  // The scan's deskew: whether its points have times, the velocity its vertices are deskewed under and
+  // whether a gyro's rotation turned them (it then stays through every deskew after the projection).
   TimeSource scan_times_ = TimeSource::none;
   SweepVelocity scan_velocity_{};
+  bool scan_turned_ = false;
   DeviceArray<ClosestKey> pixel_keys_;
   DeviceArray<ClosestKey> closest_keys_;        // the model update's first round
   DeviceArray<ClosestKey> pixel_surface_keys_;  // ... and its second

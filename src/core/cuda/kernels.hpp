@@ -67,6 +67,11 @@ void projectScan(const UploadedCloud& cloud, const SphericalProjection& projecti
 // deskew.cu: every occupied pixel deskewed again, under `velocity` after `applied` (redeskewPixel()).
 void deskewScan(const DeviceScan& scan, const SweepVelocity& applied, const SweepVelocity& velocity,
                 cudaStream_t stream);
+// deskew.cu: every occupied pixel of a scan turned by a gyro's rotation (SweepRotation) deskewed again,
+// under `velocity` after `applied`: moved by the change of translation (turnedPixelMoved()); the normals
+// stay.
+void deskewTurnedScan(const DeviceScan& scan, const SweepVelocity& applied, const SweepVelocity& velocity,
+                      cudaStream_t stream);
 
 // ground_segmentation.cu (Sec. III-C.1).
 void segmentGround(const DeviceScan& scan, const GroundBand& band, cudaStream_t stream);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "elo/se3.hpp"
 
@@ -104,14 +105,60 @@ std::string ImuTrack::rotation(double from, double to, Eigen::Matrix3d& rotation
   return {};
 }
 
+Eigen::Vector3d ImuTrack::rateAt(double time) const {
+  const auto before = [](const ImuSample& sample, double t) { return sample.stamp < t; };
+  size_t i = static_cast<size_t>(std::lower_bound(samples_.begin(), samples_.end(), time, before) - samples_.begin());
+  i = std::min(std::max<size_t>(i, 1), samples_.size() - 1);
+  const ImuSample& a = samples_[i - 1];
+  const ImuSample& b = samples_[i];
+  const double share = b.stamp > a.stamp ? (time - a.stamp) / (b.stamp - a.stamp) : 0.0;
+  return lidar_from_imu_ * (a.angular_velocity + (b.angular_velocity - a.angular_velocity) * share - learnt_bias_);
+}
+
+std::string ImuTrack::sweepRotation(double reference, double from, double to, GyroSweep& sweep) const {
+  constexpr int kKnots = GyroSweep::kIntervals + 1;
+  // The last knot at `to` itself: the samples cover that much, and maybe not a rounding beyond.
+  const auto knot = [&](int k) {
+    return k == GyroSweep::kIntervals ? to : from + k * (to - from) / GyroSweep::kIntervals;
+  };
+  // Each knot's frame in the first knot's, interval after interval, then in the reference's.
+  std::vector<Eigen::Matrix3d> from_first(kKnots, Eigen::Matrix3d::Identity());
+  for (int k = 1; k < kKnots; ++k) {
+    Eigen::Matrix3d interval;
+    const std::string issue = rotation(knot(k - 1), knot(k), interval);
+    if (!issue.empty()) return issue;
+    from_first[k] = from_first[k - 1] * interval;
+  }
+  Eigen::Matrix3d reference_from_first;
+  const std::string issue = rotation(from, reference, reference_from_first);
+  if (!issue.empty()) return issue;
+  sweep.first = from - reference;
+  sweep.last = to - reference;
+  sweep.rotations.clear();
+  sweep.rates.clear();
+  for (int k = 0; k < kKnots; ++k) {
+    sweep.rotations.push_back(reference_from_first.transpose() * from_first[k]);
+    sweep.rates.push_back(rateAt(knot(k)));
+  }
+  return {};
+}
+
 GyroMotion ImuTrack::scanMotion(double previous_reference, double reference, double sweep_from,
-                                double sweep_to) const {
+                                double sweep_to, double stamp) const {
   GyroMotion motion;
   Eigen::Matrix3d over_sweep;
   motion.fallback = rotation(previous_reference, reference, motion.rotation);
   if (motion.fallback.empty()) motion.fallback = rotation(sweep_from, sweep_to, over_sweep);
+  if (motion.fallback.empty()) motion.fallback = sweepRotation(reference, sweep_from, sweep_to, motion.sweep);
   motion.known = motion.fallback.empty();
-  if (motion.known) motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
+  if (!motion.known) return motion;
+  motion.sweep_rate = logSO3(over_sweep) / (sweep_to - sweep_from);
+  // A stamp beyond the samples (a driver's stamp past the sweep) turns at the sweep's mean rate.
+  if (rotation(std::min(stamp, reference), std::max(stamp, reference), motion.stamp_rotation).empty()) {
+    if (stamp < reference) motion.stamp_rotation.transposeInPlace();
+  } else {
+    motion.stamp_rotation = rotationOf((stamp - reference) * motion.sweep_rate);
+  }
   return motion;
 }
 
