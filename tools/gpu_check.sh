@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The CUDA backend's check, in one table: the CPU/CUDA agreement tests (every stage, whole drives, maps,
-# localization, a start in motion, refused registrations), compute-sanitizer's memcheck, racecheck,
-# initcheck and synccheck over a few real scans (deskew on, so that every kernel runs) and over
-# localization's map rendering, elo_run's poses with and without the overlapped upload, localization on
-# both backends, and the CPU-against-GPU bench, frame-to-model, over simulated drives of three sensors and
-# the real scans.
+# localization, a start in motion, refused registrations, the IMU), compute-sanitizer's memcheck,
+# racecheck, initcheck and synccheck over a few real scans (deskew on, so that every kernel runs), over
+# localization's map rendering and over a walk deskewed by the gyro, elo_run's poses on both backends
+# with the IMU and with and without the overlapped upload, localization on both backends, and the
+# CPU-against-GPU bench, frame-to-model, over simulated drives of three sensors and the real scans.
 #
 # On a GPU machine with a full build:   tools/gpu_check.sh build/devel/lib/elo_odometry [SCANS_DIR]
 # From a kit packed by gpu_kit.sh:      bash .gpukit/setup.sh && source .gpukit/env.sh && tools/gpu_check.sh
@@ -129,6 +129,33 @@ check_localization() {
     check_sanitizer $tool "$(sanitizer_summary $tool)" "5 scans localized" "$input" --localize "$map"
   done
 }
+# The IMU (docs/imu.md) on each backend: a VLP-16 carried by hand, swung at up to 188 deg/s, its sweeps
+# deskewed point by point with a consumer-grade gyro's rotation (the projection's SweepRotation) and its
+# accelerometers in the prior. The row gives by how much the two backends' poses differ; the sanitizers
+# run over the gyro's deskew kernels.
+check_imu() {
+  local walk=$work/imu_walk cpu cuda difference imu
+  "$bin/elo_sim" --world urban --trajectory curves --frames 150 --seed 11 --sensor vlp16 --gait walk --deskewed 0 \
+    --time-convention azimuth --imu consumer --output "$walk" >/dev/null ||
+    { fail "IMU walk" "elo_sim failed"; return; }
+  imu=(--config "$configs/vlp16.yaml" --config "$walk/imu.yaml" --set deskew.time_source=azimuth)
+  cpu=$("$bin/elo_run" --input "$walk" --output "$work/imu_cpu.txt" --quiet --backend cpu "${imu[@]}" 2>&1) ||
+    { fail "IMU walk" "CPU: $(tail -1 <<<"$cpu")"; return; }
+  cuda=$("$bin/elo_run" --input "$walk" --output "$work/imu_cuda.txt" --quiet --backend cuda "${imu[@]}" 2>&1) ||
+    { fail "IMU walk" "CUDA: $(tail -1 <<<"$cuda")"; return; }
+  difference=$(paste -d' ' "$work/imu_cpu.txt" "$work/imu_cuda.txt" | awk '
+    { for (i = 4; i <= 12; i += 4) { d = $i - $(i + 12); if (d < 0) d = -d; if (d > worst) worst = d } }
+    END { printf "%.2g", worst + 0 }')
+  if awk -v d="$difference" 'BEGIN { exit !(d > 1e-2) }'; then
+    fail "IMU walk, VLP-16 swung, 150 scans" "CPU and CUDA poses differ by up to $difference m"
+  else
+    row "IMU walk, VLP-16 swung, 150 scans" "CPU and CUDA poses within $difference m; FPS CPU\
+ $(sed -n 's/^FPS: \([0-9.]*\) (pipeline).*/\1/p' <<<"$cpu"), CUDA $(sed -n 's/^FPS: \([0-9.]*\) (pipeline).*/\1/p' <<<"$cuda")"
+  fi
+  for tool in memcheck racecheck initcheck synccheck; do
+    check_sanitizer $tool "$(sanitizer_summary $tool)" "5 scans, IMU walk" "$walk" "${imu[@]}"
+  done
+}
 sanitizer_summary() { if [ "$1" = racecheck ]; then echo "RACECHECK SUMMARY"; else echo "ERROR SUMMARY"; fi; }
 fps_with_localization() { sed -n 's/^FPS with localization: \([0-9.]*\).*/\1/p' <<<"$1"; }
 
@@ -145,6 +172,7 @@ check_agreement
 # Localization first after the agreement tests: its map rendering is the newest CUDA code.
 simulate hdl64 urban curves "$work/hdl64"
 check_localization "HDL-64E, urban, $frames scans" "$work/hdl64"
+check_imu
 # The real scans deskewed by azimuth, so that every kernel of the odometry runs.
 for tool in memcheck racecheck initcheck synccheck; do
   check_sanitizer $tool "$(sanitizer_summary $tool)" "5 real scans" "$scans" --set deskew.time_source=azimuth

@@ -176,12 +176,12 @@ TEST(ConfigYaml, DumpNestsEveryParameterWithItsDescription) {
   }
 }
 
-// The .yaml files in config/ (none when the tree is absent).
+// The .yaml files in config/ and its platforms/ (none when the tree is absent).
 std::vector<fs::path> shippedConfigs() {
   std::vector<fs::path> files;
   const fs::path directory = fs::path(ELO_SOURCE_DIR) / "config";
   if (!fs::is_directory(directory)) return files;
-  for (const fs::directory_entry& entry : fs::directory_iterator(directory)) {
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(directory)) {
     if (entry.path().extension() == ".yaml") files.push_back(entry.path());
   }
   return files;

@@ -77,7 +77,7 @@ TEST(RosParameters, NestedKeysSetTheTableParameters) {
 TEST(RosParameters, EveryConfigFileMatchesLoadConfigYaml) {
   const std::filesystem::path directory = std::filesystem::path(ELO_SOURCE_DIR) / "config";
   size_t files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(directory)) {
     if (entry.path().extension() != ".yaml") continue;
     ++files;
     elo::Config from_yaml;
