@@ -102,6 +102,13 @@ check_prefetch() {
     <<<"$with") ms a scan, $(awk '/^scan upload to GPU/ {print $5}' <<<"$without") ms with --no-prefetch"
 }
 
+# The largest difference between two KITTI pose files' translations (entries 4, 8 and 12 of a line), m.
+largest_translation_difference() {
+  paste -d' ' "$1" "$2" | awk '
+    { for (i = 4; i <= 12; i += 4) { d = $i - $(i + 12); if (d < 0) d = -d; if (d > worst) worst = d } }
+    END { printf "%.2g", worst + 0 }'
+}
+
 # Localization (docs/localization.md) on each backend: a map of the drive (elo_run --map), the drive
 # localized in it from the map's origin. The row gives by how much the two backends' poses differ and
 # each one's FPS, odometry and map match together.
@@ -115,10 +122,7 @@ check_localization() {
     --backend cuda 2>&1) || { fail "localization, $name" "CUDA: $(tail -1 <<<"$cuda")"; return; }
   echo "--- localization, $name, CUDA" >>"$work/bench.log"
   echo "$cuda" >>"$work/bench.log"
-  # KITTI lines: the translation is entries 4, 8 and 12.
-  difference=$(paste -d' ' "$work/localized_cpu.txt" "$work/localized_cuda.txt" | awk '
-    { for (i = 4; i <= 12; i += 4) { d = $i - $(i + 12); if (d < 0) d = -d; if (d > worst) worst = d } }
-    END { printf "%.2g", worst + 0 }')
+  difference=$(largest_translation_difference "$work/localized_cpu.txt" "$work/localized_cuda.txt")
   if awk -v d="$difference" 'BEGIN { exit !(d > 1e-3) }'; then
     fail "localization, $name" "CPU and CUDA poses differ by up to $difference m"
     return
@@ -143,9 +147,7 @@ check_imu() {
     { fail "IMU walk" "CPU: $(tail -1 <<<"$cpu")"; return; }
   cuda=$("$bin/elo_run" --input "$walk" --output "$work/imu_cuda.txt" --quiet --backend cuda "${imu[@]}" 2>&1) ||
     { fail "IMU walk" "CUDA: $(tail -1 <<<"$cuda")"; return; }
-  difference=$(paste -d' ' "$work/imu_cpu.txt" "$work/imu_cuda.txt" | awk '
-    { for (i = 4; i <= 12; i += 4) { d = $i - $(i + 12); if (d < 0) d = -d; if (d > worst) worst = d } }
-    END { printf "%.2g", worst + 0 }')
+  difference=$(largest_translation_difference "$work/imu_cpu.txt" "$work/imu_cuda.txt")
   if awk -v d="$difference" 'BEGIN { exit !(d > 1e-2) }'; then
     fail "IMU walk, VLP-16 swung, 150 scans" "CPU and CUDA poses differ by up to $difference m"
   else
