@@ -126,7 +126,7 @@ Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
   }
   if (gyro_.known) guess.linear() = gyro_.rotation;
   if (motion_.known() && inertialPriorKnown()) {
-    guess.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
+    guess.translation() = inertialTranslation();
   }
   return guess;
 }
@@ -244,7 +244,7 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
   result.delta = expSE3(held_velocity_ * dt);
   if (gyro_.known) result.delta.linear() = gyro_.rotation;
   if (inertialPriorKnown()) {
-    result.delta.translation() = inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
+    result.delta.translation() = inertialTranslation();
   }
   result.pose = pose_ * result.delta;
   motion_.reset();

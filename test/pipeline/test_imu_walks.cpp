@@ -13,13 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "elo/eval/kitti_metric.hpp"
 #include "elo/imu/inertial_filter.hpp"
-#include "elo/io/config_yaml.hpp"
 #include "elo/pipeline/deskew.hpp"
 #include "elo/pipeline/odometry.hpp"
 #include "elo/sim/imu.hpp"
 #include "simulated_walks.hpp"
+#include "walk_scoring.hpp"
 
 namespace elo {
 namespace {
@@ -69,7 +68,7 @@ ImuRun walkWithImu(const sim::Simulation& simulation, const std::vector<ImuSampl
 }
 
 double tRelOver10m(const ImuRun& run) {
-  return averageDrift(kittiSegmentErrors(run.truth, run.estimate, {10.0}, 1)).t_rel_percent;
+  return test::driftOver10m(run.truth, run.estimate).t_rel_percent;
 }
 
 size_t total(const std::map<std::string, size_t>& counts) {
@@ -298,7 +297,7 @@ TEST_F(ImuWalk, AGapInTheSamplesFallsBackForTheScansItCovers) {
 TEST(ImuHandheldWalk, InstantaneousScansUnderTheHandheldBoundsStayOnTrack) {
   const test::Walk walk{"vlp16_walk_instantaneous", "vlp16", false, false, 0.0};
   sim::SimulationSpec spec = test::walkSpec(walk, kFrames);
-  loadConfigYaml(std::string(ELO_SOURCE_DIR) + "/config/platforms/handheld.yaml", spec.config);
+  test::loadPlatform("handheld", spec.config);
   const sim::Simulation simulation(spec);
   const std::vector<ImuSample> samples = sim::simulateImu(simulation, sim::consumerImu(), kImuRate, 3);
   Odometry odometry(withImu(spec.config));

@@ -11,10 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "elo/eval/kitti_metric.hpp"
-#include "elo/io/config_yaml.hpp"
 #include "elo/pipeline/odometry.hpp"
 #include "simulated_walks.hpp"
+#include "walk_scoring.hpp"
 
 namespace elo {
 namespace {
@@ -82,7 +81,7 @@ TEST_P(HandheldWalk, StaysWithinTheBoundsSkipsNoScanAndRecovers) {
   const sim::Simulation simulation(spec);
   Odometry odometry(spec.config);
   const WalkRun run = walkThrough(simulation, odometry);
-  const DriftError drift = averageDrift(kittiSegmentErrors(run.truth, run.estimate, {10.0}, 1));
+  const DriftError drift = test::driftOver10m(run.truth, run.estimate);
   std::printf("[ walk     ] %s: t_rel over 10 m %.2f %%, r_rel %.1f deg/100m; fastest accepted %.2f m/s, %.0f deg/s; "
               "%zu refused, %zu recovered, %zu restarts, %zu skipped\n",
               walk.name.c_str(), drift.t_rel_percent, drift.r_rel_deg_per_100m, run.fastest.speed,
@@ -120,11 +119,11 @@ TEST_P(PlatformWalk, ThePlatformsBoundsKeepTheTrack) {
   constexpr int kFrames = 150;
   sim::SimulationSpec spec = walkSpec(walk, kFrames);
   const std::string platform = walk.trot ? "legged" : "handheld";
-  loadConfigYaml(std::string(ELO_SOURCE_DIR) + "/config/platforms/" + platform + ".yaml", spec.config);
+  test::loadPlatform(platform, spec.config);
   const sim::Simulation simulation(spec);
   Odometry odometry(spec.config);
   const WalkRun run = walkThrough(simulation, odometry);
-  const DriftError drift = averageDrift(kittiSegmentErrors(run.truth, run.estimate, {10.0}, 1));
+  const DriftError drift = test::driftOver10m(run.truth, run.estimate);
   std::printf("[ walk     ] %s, %s bounds: t_rel over 10 m %.2f %%; fastest accepted %.2f m/s; %zu refused, "
               "%zu recovered, %zu restarts, %zu skipped\n",
               walk.name.c_str(), platform.c_str(), drift.t_rel_percent, run.fastest.speed, refusedIn(odometry),

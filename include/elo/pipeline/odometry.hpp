@@ -224,6 +224,10 @@ class Odometry {
   // Whether the accelerometers give this scan's translation: the IMU covered its interval and the inertial
   // filter's velocity is known.
   bool inertialPriorKnown() const { return inertial_interval_known_ && inertial_.ready(); }
+  // The scan's translation since the last accepted one by the accelerometers (inertialPriorKnown()).
+  Eigen::Vector3d inertialTranslation() const {
+    return inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
+  }
   // The accepted registration `reference_delta` corrects the inertial filter, which moves on to this scan
   // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
   // reference frame in the world.
