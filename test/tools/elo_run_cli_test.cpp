@@ -266,6 +266,13 @@ TEST_F(EloRunCli, StartBeyondTheInputOrWithReverseIsAUsageError) {
 // kitti_to_bag's start time: the bag's header stamps are the sequence's times plus this.
 constexpr double kBagStartTime = 1.0;
 
+// Scan `i` of `sequence` as the bags written here carry it: in frame velodyne, kBagStartTime later.
+sensor_msgs::PointCloud2 bagCloud(const elo::Sequence& sequence, size_t i) {
+  elo::PointCloud cloud = sequence.load(i);
+  cloud.stamp += kBagStartTime;
+  return elo_ros::toPointCloud2(cloud, "velodyne");
+}
+
 CommandResult writeRos1Bag(const std::string& sequence, const std::string& bag) {
   return runCommand(std::string(KITTI_TO_BAG_TOOL) + " --input " + sequence + " --output " + bag +
                     " --poses-frame lidar");
@@ -312,9 +319,7 @@ TEST_F(EloRunCli, BagWithSeveralCloudTopicsNeedsTopic) {
     const elo::Sequence sequence(sequence_.string());
     rosbag::Bag writer(bag, rosbag::bagmode::Write);
     for (size_t i = 0; i < sequence.size(); ++i) {
-      elo::PointCloud cloud = sequence.load(i);
-      cloud.stamp += kBagStartTime;
-      const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      const sensor_msgs::PointCloud2 message = bagCloud(sequence, i);
       writer.write("/front/points", message.header.stamp, message);
       if (i < 2) writer.write("/rear/points", message.header.stamp, message);
     }
@@ -337,9 +342,7 @@ TEST_F(EloRunCli, MalformedCloudInABagIsSkippedAndCounted) {
     const elo::Sequence sequence(sequence_.string());
     rosbag::Bag writer(bag, rosbag::bagmode::Write);
     for (size_t i = 0; i < sequence.size(); ++i) {
-      elo::PointCloud cloud = sequence.load(i);
-      cloud.stamp += kBagStartTime;
-      sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      sensor_msgs::PointCloud2 message = bagCloud(sequence, i);
       if (i == 2) message.data.resize(message.data.size() / 2);
       writer.write("/points", message.header.stamp, message);
     }
@@ -537,9 +540,7 @@ TEST_F(EloRunCli, BagWithTwoImuTopicsNeedsImuTopicAndSkipsAMalformedMessage) {
     const elo::Sequence sequence(sequence_.string());
     rosbag::Bag writer(bag, rosbag::bagmode::Write);
     for (size_t i = 0; i < sequence.size(); ++i) {
-      elo::PointCloud cloud = sequence.load(i);
-      cloud.stamp += kBagStartTime;
-      const sensor_msgs::PointCloud2 message = elo_ros::toPointCloud2(cloud, "velodyne");
+      const sensor_msgs::PointCloud2 message = bagCloud(sequence, i);
       writer.write("/points", message.header.stamp, message);
     }
     const double end = sequence.stamp(sequence.size() - 1) + kBagStartTime + 0.2;
