@@ -505,7 +505,8 @@ TEST(DeskewTimes, PointsWithATimeOutsideTheSweepAreDroppedAndCounted) {
 
 // A drive at 10 m/s, turning: deskewed (by either time source) the odometry tracks the truth as on
 // instantaneous scans; as measured it drifts. The second scan registers against the first as measured
-// (nothing is known of the motion before), exactly as without deskew.
+// (nothing is known of the motion before), exactly as without deskew, 8 mm off the truth; then both are
+// deskewed under the motion found and registered again, within a millimetre.
 struct DriveError {
   double second_scan_mm = 0.0;  // translation error of the second scan
   double drift_mm = 0.0;        // the largest translation error after it, relative to it
@@ -568,22 +569,20 @@ TEST_P(DeskewedDrive, TracksAsOnInstantaneousScans) {
     std::printf("deskewed (%s): %.1f / %.3f; second scan %.2f mm, as measured %.2f mm\n",
                 source == TimeSource::field ? "field" : "azimuth", deskewed.drift_mm, deskewed.drift_deg,
                 deskewed.second_scan_mm, distorted.second_scan_mm);
-    EXPECT_EQ(deskewed.second_scan_mm, distorted.second_scan_mm);
+    EXPECT_LT(deskewed.second_scan_mm, std::min(1.0, 0.05 * distorted.second_scan_mm));
     EXPECT_LT(deskewed.drift_mm, std::max(2.0 * instantaneous.drift_mm, 3.0));
     EXPECT_LT(deskewed.drift_deg, std::max(2.0 * instantaneous.drift_deg, 0.01));
     EXPECT_LT(deskewed.drift_mm, 0.1 * distorted.drift_mm);
   }
   // Stamped at the sweep's start, the scans are registered at mid-sweep all the same and reported at
-  // their stamps, half a sweep before, under each scan's velocity. The second scan's velocity, from its
-  // registration against the first as measured (8 mm off), places the stamps a few mm off (4.4 / 3.7
-  // mm in f2m / f2f, against 1.4 / 2.2 stamped mid-sweep): an offset, not a drift.
+  // their stamps, half a sweep before, under each scan's velocity. The first two scans' stamps are
+  // placed under the motion their deskewed scans registered: under the bent scans' (8 mm off in 0.1 s)
+  // every later pose was 4.4 / 3.7 mm off (f2m / f2f), now 0.6 / 0.5 mm as stamped mid-sweep.
   const DriveError from_start = driveError(TimeSource::field, GetParam(), true, 0.05);
   std::printf("deskewed (field, stamped at the sweep's start): %.1f / %.3f; second scan %.2f mm\n",
               from_start.drift_mm, from_start.drift_deg, from_start.second_scan_mm);
-  // The second scan registers against the first as measured: the motion between like instants of the
-  // two sweeps, mid-sweep's or the stamps' alike at a constant velocity (up to rounding).
-  EXPECT_NEAR(from_start.second_scan_mm, distorted.second_scan_mm, 1e-6);
-  EXPECT_LT(from_start.drift_mm, 0.1 * distorted.drift_mm);
+  EXPECT_LT(from_start.second_scan_mm, std::min(1.0, 0.05 * distorted.second_scan_mm));
+  EXPECT_LT(from_start.drift_mm, std::max(2.0 * instantaneous.drift_mm, 3.0));
   EXPECT_LT(from_start.drift_deg, std::max(2.0 * instantaneous.drift_deg, 0.01));
 }
 

@@ -236,6 +236,14 @@ class Odometry {
   Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
   void deskewScanAgain(const Vector6d& velocity, FrameResult& result);
+  // Sec. III-C: ground segmentation, normals and the BEV ground map of the projected scan.
+  void extractFeatures();
+  // The second scan of a start, registered against the first as both were measured (model_provisional_):
+  // both deskewed under the motion found, the first made the model again, the second registered against
+  // it. Returns the velocity the two scans' stamps are placed under (acceptRegistration()): the one the
+  // deskewed scans registered.
+  Vector6d registerAgainstDeskewedStart(const PointCloud& cloud, float stamp, const CloudTimes& times, double dt,
+                                        const Vector6d& velocity, FrameResult& result);
 
   Config config_;
   std::unique_ptr<Backend> backend_;
@@ -249,10 +257,15 @@ class Odometry {
   double last_reference_ = 0.0;
   bool started_ = false;
   // The model holds only the first scan of a start, which had per-point times but no motion to deskew
-  // them with: the next registered scan, deskewed with its registered motion, replaces it instead of
-  // joining it. Fused, its distorted points would stay (the oldest point on a surface does) and bias
-  // the registrations of the next model.time_window seconds.
+  // them with. Fused, its distorted points would stay (the oldest point on a surface does) and bias the
+  // registrations of the next model.time_window seconds: the next scan, registered against it as measured,
+  // tells the motion, and the first scan deskewed under it becomes the model instead
+  // (registerAgainstDeskewedStart()); a registration that did not converge replaces it with its own scan.
   bool model_provisional_ = false;
+  // The provisional model's scan as measured, how it was projected, and its relative stamp.
+  PointCloud provisional_cloud_;
+  SweepMotion provisional_motion_;
+  float provisional_stamp_ = 0.0f;
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
   double last_since_first_ = 0.0;  // secondsSinceFirst(last_stamp_)
