@@ -207,8 +207,13 @@ Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& referenc
   // sweep, which the stamp at one end of a sweep swung at a changing rate would miss by up to a degree.
   if (gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   // The first scan of a start had no velocity to place its stamp in its sweep; registered against it as
-  // measured (bent alike), this scan measured the motion between like instants of the two sweeps.
-  if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
+  // measured (bent alike), this scan measured the motion between like instants of the two sweeps. Turned
+  // by the gyro, its stamp's turn is the one the gyro measured over its own sweep.
+  if (model_provisional_) {
+    const Eigen::Isometry3d as_measured = expSE3(-last_reference_ * deskewed_under);
+    if (!provisional_turned_by_gyro_) stamp_in_reference_.linear() = as_measured.linear();
+    stamp_in_reference_.translation() = as_measured.translation();
+  }
   // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
   result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
   pose_ = pose_ * result.delta;
@@ -264,7 +269,12 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
 }
 
 void Odometry::searchMotion(double dt, FrameResult& result) {
-  result.start_search = searchStartMotion(*backend_, dt, config_, expSE3(held_velocity_ * dt));
+  Eigen::Isometry3d centre = expSE3(held_velocity_ * dt);
+  // With the gyro's rotation over the interval every candidate takes it: a sensor turning fast at a start
+  // (a handheld rig started mid-swing) is found by translations alone.
+  if (gyro_.known) centre.linear() = gyro_.rotation;
+  result.start_search = searchStartMotion(*backend_, dt, config_, centre,
+                                          gyro_.known ? StartRotation::from_gyro : StartRotation::search_yaw);
   ++start_searches_;
   if (result.start_search.ambiguous) ++ambiguous_starts_;
 }
@@ -374,6 +384,9 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   stage_start = Clock::now();
   if (model_provisional_) backend_->resetModel();
   model_provisional_ = !started_ && times.source != TimeSource::none;
+  provisional_turned_by_gyro_ = model_provisional_ && gyro_.known;
+  // The first scan of a start turned by the gyro: its stamp's turn in its reference frame is the gyro's.
+  if (!started_ && gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   backend_->updateModel(reference_delta, relative_stamp);
   backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);
