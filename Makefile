@@ -121,7 +121,7 @@ test-aarch64: deps-aarch64
 # says where the corpus grows and where a crasher lands.
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := fuzz_cloud_conversion fuzz_cdr_point_cloud2 fuzz_kitti_bin fuzz_pcd fuzz_kitti_text fuzz_config_yaml
+FUZZ_TARGETS := fuzz_cloud_conversion fuzz_cdr_point_cloud2 fuzz_cdr_imu fuzz_kitti_bin fuzz_pcd fuzz_kitti_text fuzz_config_yaml
 fuzz: DEB_PACKAGES += clang libclang-rt-14-dev
 fuzz: deps
 	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DELO_FUZZ=ON \

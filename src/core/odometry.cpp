@@ -207,8 +207,9 @@ Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& referenc
   // sweep, which the stamp at one end of a sweep swung at a changing rate would miss by up to a degree.
   if (gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   // The first scan of a start had no velocity to place its stamp in its sweep; registered against it as
-  // measured (bent alike), this scan measured the motion between like instants of the two sweeps.
-  if (model_provisional_) stamp_in_reference_ = expSE3(-last_reference_ * deskewed_under);
+  // measured (bent alike), this scan measured the motion between like instants of the two sweeps. Turned
+  // by the gyro, its stamp's turn is the one the gyro measured over its own sweep.
+  if (model_provisional_) placeFirstStamp(deskewed_under);
   // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
   result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
   pose_ = pose_ * result.delta;
@@ -260,8 +261,14 @@ Vector6d Odometry::registerAgainstDeskewedStart(const PointCloud& cloud, float s
   // 10 m/s), too little to deskew them again but not to place a stamp half a sweep from its reference:
   // both scans' stamps are placed under it, as the next scan's will be under the motion prior's.
   const Vector6d refined = withGyroRate(sweepVelocity(result.registration.model_from_scan, dt));
-  stamp_in_reference_ = expSE3(-last_reference_ * refined);
+  placeFirstStamp(refined);
   return refined;
+}
+
+void Odometry::placeFirstStamp(const Vector6d& velocity) {
+  const Eigen::Isometry3d under_velocity = expSE3(-last_reference_ * velocity);
+  if (!provisional_turned_by_gyro_) stamp_in_reference_.linear() = under_velocity.linear();
+  stamp_in_reference_.translation() = under_velocity.translation();
 }
 
 Vector6d Odometry::searchAfterRefusal(double dt, const Vector6d& projected_under, const Vector6d& deskewed_under,
@@ -302,7 +309,12 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
 }
 
 void Odometry::searchMotion(double dt, FrameResult& result) {
-  result.start_search = searchStartMotion(*backend_, dt, config_, expSE3(held_velocity_ * dt));
+  Eigen::Isometry3d centre = expSE3(held_velocity_ * dt);
+  // With the gyro's rotation over the interval every candidate takes it: a sensor turning fast at a start
+  // (a handheld rig started mid-swing) is found by translations alone.
+  if (gyro_.known) centre.linear() = gyro_.rotation;
+  result.start_search = searchStartMotion(*backend_, dt, config_, centre,
+                                          gyro_.known ? StartRotation::from_gyro : StartRotation::search_yaw);
   ++start_searches_;
   if (result.start_search.ambiguous) ++ambiguous_starts_;
 }
@@ -418,6 +430,9 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     provisional_motion_ = {times.source, Vector6d::Zero(), times.reference, gyro_.sweep};
     provisional_stamp_ = relative_stamp;
   }
+  provisional_turned_by_gyro_ = model_provisional_ && gyro_.known;
+  // The first scan of a start turned by the gyro: its stamp's turn in its reference frame is the gyro's.
+  if (!started_ && gyro_.known) stamp_in_reference.linear() = gyro_.stamp_rotation;
   backend_->updateModel(reference_delta, relative_stamp);
   backend_->synchronize();
   result.times.model_update = millisecondsSince(stage_start);

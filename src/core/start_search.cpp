@@ -85,26 +85,30 @@ double fitScore(const NormalEquations& sums, const RegistrationConfig& config) {
 }
 
 StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
-                                    const Eigen::Isometry3d& centre) {
+                                    const Eigen::Isometry3d& centre, StartRotation rotation) {
   const auto start = Clock::now();
   const StartSearchConfig& search = config.start_search;
   const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * dt;
   // Along x first, then in yaw around where the best along x started: a turn within the search's yaw
   // reach hardly moves where the scan fits along x, so the two are searched one after the other rather
-  // than on a grid of both, at a third of its cost.
+  // than on a grid of both, at a third of its cost. The gyro's rotation is good to a small fraction of a
+  // yaw step (a bias of 0.5 deg/s turns 0.05 deg a scan), so centred on it the yaw candidates add nothing.
   std::vector<Candidate> scored;
   const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(centre, config.motion.max_speed * dt, search);
   for (const Eigen::Isometry3d& motion : along_x) {
     scored.push_back(registerCandidate(backend, motion, config.registration));
   }
   const auto better = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
-  const size_t best_along_x = std::min_element(scored.begin(), scored.end(), better) - scored.begin();
-  for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x], yaw_reach, search)) {
-    scored.push_back(registerCandidate(backend, motion, config.registration));
+  if (rotation == StartRotation::search_yaw) {
+    const size_t best_along_x = std::min_element(scored.begin(), scored.end(), better) - scored.begin();
+    for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x], yaw_reach, search)) {
+      scored.push_back(registerCandidate(backend, motion, config.registration));
+    }
   }
   const Candidate winner = *std::min_element(scored.begin(), scored.end(), better);
   StartSearchResult result;
   result.searched = true;
+  result.rotation = rotation;
   result.candidates = static_cast<int>(scored.size());
   result.motion = winner.motion;
   result.score = winner.score;

@@ -1,102 +1,15 @@
 #include "elo/io/cdr_point_cloud2.hpp"
 
-#include <algorithm>
-#include <cstring>
 #include <string>
 
-#include "elo/io/io_error.hpp"
+#include "cdr_reader.hpp"
 
 namespace elo {
 namespace {
 
-constexpr size_t kEncapsulationBytes = 4;
+using io_detail::CdrReader;
 
-// Reads plain CDR: the encapsulation header says the byte order; a primitive of n bytes starts at a
-// multiple of n (at most 8) counted from the end of that header.
-class CdrReader {
- public:
-  CdrReader(const uint8_t* data, size_t size) : data_(data), size_(size) {
-    if (size < kEncapsulationBytes) fail("shorter than the 4-byte CDR encapsulation header");
-    if (data[0] != 0 || data[1] > 1) {
-      fail("encapsulation " + std::to_string(data[0]) + "," + std::to_string(data[1]) +
-           " is not plain CDR (0,0 big-endian or 0,1 little-endian): ROS 2 bags hold plain CDR");
-    }
-    swap_bytes_ = (data[1] == 0) != hostIsBigEndian();
-    position_ = kEncapsulationBytes;
-  }
-
-  template <typename T>
-  T read(const char* what) {
-    align(sizeof(T));
-    require(sizeof(T), what);
-    uint8_t bytes[sizeof(T)];
-    std::memcpy(bytes, data_ + position_, sizeof(T));
-    if (swap_bytes_) std::reverse(bytes, bytes + sizeof(T));
-    position_ += sizeof(T);
-    T value;
-    std::memcpy(&value, bytes, sizeof(T));
-    return value;
-  }
-
-  bool readBool(const char* what) { return read<uint8_t>(what) != 0; }
-
-  // A CDR string: a uint32 length that counts the terminating NUL, the characters, the NUL.
-  std::string readString(const char* what) {
-    const uint32_t length = read<uint32_t>(what);
-    require(length, what);
-    const char* characters = reinterpret_cast<const char*>(data_ + position_);
-    position_ += length;
-    return length == 0 ? std::string() : std::string(characters, strnlen(characters, length - 1));
-  }
-
-  // A sequence's element count, checked against the bytes left (each element takes at least
-  // `min_element_bytes`), so that a corrupt count cannot make the caller reserve gigabytes.
-  uint32_t readCount(size_t min_element_bytes, const char* what) {
-    const uint32_t count = read<uint32_t>(what);
-    if (static_cast<uint64_t>(count) * min_element_bytes > size_ - position_) {
-      fail(std::string(what) + " says " + std::to_string(count) + " elements, but only " +
-           std::to_string(size_ - position_) + " bytes follow");
-    }
-    return count;
-  }
-
-  const uint8_t* readBytes(size_t count, const char* what) {
-    require(count, what);
-    const uint8_t* bytes = data_ + position_;
-    position_ += count;
-    return bytes;
-  }
-
-  [[noreturn]] void fail(const std::string& problem) const {
-    throw IoError("malformed CDR PointCloud2 (byte " + std::to_string(position_) + " of " + std::to_string(size_) +
-                  "): " + problem);
-  }
-
- private:
-  void align(size_t alignment) {
-    const size_t offset = position_ - kEncapsulationBytes;
-    position_ += (alignment - offset % alignment) % alignment;
-    position_ = std::min(position_, size_);  // padding past the end: the read that follows fails
-  }
-
-  void require(size_t count, const char* what) const {
-    if (count > size_ - position_) {
-      fail(std::string("truncated in ") + what + ": " + std::to_string(count) + " bytes needed, " +
-           std::to_string(size_ - position_) + " left");
-    }
-  }
-
-  const uint8_t* data_;
-  size_t size_;
-  size_t position_ = 0;
-  bool swap_bytes_ = false;
-};
-
-double readStamp(CdrReader& reader) {
-  const int32_t seconds = reader.read<int32_t>("header.stamp.sec");
-  const uint32_t nanoseconds = reader.read<uint32_t>("header.stamp.nanosec");
-  return stampSeconds(seconds, nanoseconds);
-}
+constexpr char kMessageType[] = "PointCloud2";
 
 CloudField readField(CdrReader& reader) {
   CloudField field;
@@ -110,15 +23,15 @@ CloudField readField(CdrReader& reader) {
 }  // namespace
 
 double decodeCdrStamp(const uint8_t* data, size_t size) {
-  CdrReader reader(data, size);
-  return readStamp(reader);
+  CdrReader reader(data, size, kMessageType);
+  return reader.readStamp();
 }
 
 PointCloud2View decodeCdrPointCloud2(const uint8_t* data, size_t size) {
   constexpr size_t kMinFieldBytes = 13;  // name length, offset, datatype, count
-  CdrReader reader(data, size);
+  CdrReader reader(data, size, kMessageType);
   PointCloud2View view;
-  view.stamp = readStamp(reader);
+  view.stamp = reader.readStamp();
   reader.readString("header.frame_id");
   view.height = reader.read<uint32_t>("height");
   view.width = reader.read<uint32_t>("width");

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 
+#include "elo/io/cdr_imu.hpp"
 #include "elo/io/cdr_point_cloud2.hpp"
 #include "elo/io/point_cloud2.hpp"
 
@@ -46,8 +48,10 @@ class Statement {
 
 }  // namespace
 
+namespace ros2_bag_detail {
+
 // One .db3 file, open read-only for the whole run.
-class Ros2Bag::File {
+class File {
  public:
   explicit File(std::string path) : path_(std::move(path)) {
     if (sqlite3_open_v2(path_.c_str(), &database_, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
@@ -120,28 +124,39 @@ class Ros2Bag::File {
   mutable sqlite3_blob* blob_ = nullptr;  // the last message read, reopened on the next
 };
 
-bool isRos2Bag(const std::string& path) {
-  return fs::is_directory(path) && fs::exists(fs::path(path) / "metadata.yaml");
-}
+}  // namespace ros2_bag_detail
 
-Ros2Bag::Ros2Bag(const std::string& directory, const std::string& topic) : directory_(directory) {
-  const std::vector<std::string> paths = filesWithExtension(directory_, ".db3");
+namespace {
+
+using ros2_bag_detail::File;
+
+// Every .db3 file of the bag `directory`, open. Throws IoError for MCAP storage, no .db3 file, or a file
+// SQLite cannot open.
+std::vector<std::unique_ptr<File>> openBagFiles(const std::string& directory) {
+  const std::vector<std::string> paths = filesWithExtension(directory, ".db3");
   if (paths.empty()) {
-    if (!filesWithExtension(directory_, ".mcap").empty()) {
-      throw IoError("ROS 2 bag '" + directory_ + "' is stored as MCAP, which elo_run does not read: convert it to "
+    if (!filesWithExtension(directory, ".mcap").empty()) {
+      throw IoError("ROS 2 bag '" + directory + "' is stored as MCAP, which elo_run does not read: convert it to "
                     "SQLite with `ros2 bag convert` (storage_id: sqlite3)");
     }
-    throw IoError("ROS 2 bag '" + directory_ + "' holds no .db3 file");
+    throw IoError("ROS 2 bag '" + directory + "' holds no .db3 file");
   }
-  for (const std::string& path : paths) files_.push_back(std::make_unique<File>(path));
+  std::vector<std::unique_ptr<File>> files;
+  for (const std::string& path : paths) files.push_back(std::make_unique<File>(path));
+  return files;
+}
+
+// The bag's topics over all its files, each with its message count. Throws IoError when a topic of
+// `cdr_type` is serialized other than as CDR.
+std::vector<BagTopic> topicsOf(const std::vector<std::unique_ptr<File>>& files, const char* cdr_type) {
   std::map<std::string, BagTopic> topics;
-  for (const auto& file : files_) {
+  for (const auto& file : files) {
     for (const File::Topic& entry : file->topics()) {
       BagTopic& listed = topics[entry.name];
       listed.name = entry.name;
       listed.type = entry.type;
       listed.messages += file->messageCount(entry.id);
-      if (entry.type == kRos2CloudType && entry.format != "cdr") {
+      if (entry.type == cdr_type && entry.format != "cdr") {
         throw IoError("topic " + entry.name + " of '" + file->path() + "' is serialized as '" + entry.format +
                       "'; elo_run reads CDR, what ROS 2 records");
       }
@@ -149,6 +164,31 @@ Ros2Bag::Ros2Bag(const std::string& directory, const std::string& topic) : direc
   }
   std::vector<BagTopic> listed;
   for (const auto& [name, entry] : topics) listed.push_back(entry);
+  return listed;
+}
+
+// The id `topic` has in `file`; none when it was recorded in another file of the bag.
+std::optional<int64_t> topicId(const File& file, const std::string& topic) {
+  for (const File::Topic& entry : file.topics()) {
+    if (entry.name == topic) return entry.id;
+  }
+  return std::nullopt;
+}
+
+std::string damaged(const File& file) {
+  return "'" + file.path() + "' is damaged (SQLite: " + sqlite3_errmsg(file.database()) +
+         "; a copy cut short?): its messages past the damage are left out";
+}
+
+}  // namespace
+
+bool isRos2Bag(const std::string& path) {
+  return fs::is_directory(path) && fs::exists(fs::path(path) / "metadata.yaml");
+}
+
+Ros2Bag::Ros2Bag(const std::string& directory, const std::string& topic)
+    : directory_(directory), files_(openBagFiles(directory)) {
+  const std::vector<BagTopic> listed = topicsOf(files_, kRos2CloudType);
   topic_ = chooseCloudTopic("ROS 2 bag '" + directory_ + "'", listed, kRos2CloudType, topic);
   listMessages();
   if (messages_.empty()) throw IoError(describe() + " holds no message" + (warning_.empty() ? "" : " (" + warning_ + ")"));
@@ -162,12 +202,11 @@ Ros2Bag::~Ros2Bag() = default;
 void Ros2Bag::listMessages() {
   for (size_t index = 0; index < files_.size(); ++index) {
     const File& file = *files_[index];
-    const std::vector<File::Topic> topics = file.topics();
-    const auto topic = std::find_if(topics.begin(), topics.end(), [&](const File::Topic& t) { return t.name == topic_; });
-    if (topic == topics.end()) continue;  // recorded in another file of the bag
+    const std::optional<int64_t> topic = topicId(file, topic_);
+    if (!topic) continue;  // recorded in another file of the bag
     // In row order, which SQLite reads as the table is stored, one row at a time.
     Statement rows(file.database(), "SELECT id, timestamp FROM messages WHERE topic_id = ? ORDER BY id", file.path());
-    sqlite3_bind_int64(rows.get(), 1, topic->id);
+    sqlite3_bind_int64(rows.get(), 1, *topic);
     int status;
     while ((status = sqlite3_step(rows.get())) == SQLITE_ROW) {
       const int64_t row = sqlite3_column_int64(rows.get(), 0);
@@ -185,10 +224,7 @@ void Ros2Bag::listMessages() {
       sqlite3_blob_close(blob);
       messages_.push_back({index, row, stamp});
     }
-    if (status != SQLITE_DONE) {
-      warning_ += (warning_.empty() ? "" : "; ") + std::string("'") + file.path() + "' is damaged (SQLite: " +
-                  sqlite3_errmsg(file.database()) + "; a copy cut short?): its messages past the damage are left out";
-    }
+    if (status != SQLITE_DONE) warning_ += (warning_.empty() ? "" : "; ") + damaged(file);
   }
   std::stable_sort(messages_.begin(), messages_.end(),
                    [](const Message& a, const Message& b) { return a.stamp < b.stamp; });
@@ -197,6 +233,41 @@ void Ros2Bag::listMessages() {
 double Ros2Bag::stamp(size_t index) const { return messages_.at(index).stamp; }
 
 std::string Ros2Bag::describe() const { return "ROS 2 bag '" + directory_ + "', topic " + topic_; }
+
+BagImu readRos2BagImu(const std::string& directory, const std::string& topic, std::string& warning) {
+  const std::vector<std::unique_ptr<File>> files = openBagFiles(directory);
+  const std::string bag = "ROS 2 bag '" + directory + "'";
+  BagImu imu;
+  imu.topic = chooseImuTopic(bag, topicsOf(files, kRos2ImuType), kRos2ImuType, topic);
+  if (imu.topic.empty()) return imu;
+  for (const auto& file : files) {
+    const std::optional<int64_t> id = topicId(*file, imu.topic);
+    if (!id) continue;
+    // Whole messages, in row order: an Imu message is some 300 bytes.
+    Statement rows(file->database(), "SELECT id, data FROM messages WHERE topic_id = ? ORDER BY id", file->path());
+    sqlite3_bind_int64(rows.get(), 1, *id);
+    int status;
+    while ((status = sqlite3_step(rows.get())) == SQLITE_ROW) {
+      const auto* data = static_cast<const uint8_t*>(sqlite3_column_blob(rows.get(), 1));
+      const size_t size = static_cast<size_t>(sqlite3_column_bytes(rows.get(), 1));
+      try {
+        const CdrImu message = decodeCdrImu(data, size);
+        if (!message.has_angular_velocity) {
+          imu.skip(imu_message::kNoAngularVelocity);
+          continue;
+        }
+        imu.samples.push_back({message.stamp, message.angular_velocity, message.linear_acceleration});
+      } catch (const IoError& malformed) {
+        imu.skip(imu_message::kUnreadable, bag + ", topic " + imu.topic + ", message " +
+                                               std::to_string(sqlite3_column_int64(rows.get(), 0)) + " of '" +
+                                               file->path() + "': " + malformed.what());
+      }
+    }
+    if (status != SQLITE_DONE) warning += (warning.empty() ? "" : "; ") + damaged(*file);
+  }
+  imu.sortByStamp();
+  return imu;
+}
 
 LoadedScan Ros2Bag::read(size_t index) const {
   const Message& message = messages_.at(index);

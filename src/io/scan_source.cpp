@@ -34,6 +34,22 @@ std::string chooseCloudTopic(const std::string& bag, const std::vector<BagTopic>
   return clouds.front().name;
 }
 
+std::string chooseImuTopic(const std::string& bag, const std::vector<BagTopic>& topics, const std::string& imu_type,
+                           const std::string& requested) {
+  std::vector<BagTopic> imus;
+  std::copy_if(topics.begin(), topics.end(), std::back_inserter(imus),
+               [&](const BagTopic& topic) { return topic.type == imu_type; });
+  if (!requested.empty()) {
+    const bool found = std::any_of(imus.begin(), imus.end(), [&](const BagTopic& t) { return t.name == requested; });
+    if (!found) throw IoError(bag + " has no " + imu_type + " topic " + requested + "; its topics: " + listTopics(topics));
+    return requested;
+  }
+  if (imus.size() > 1) {
+    throw IoError(bag + " has several " + imu_type + " topics: " + listTopics(imus) + "; choose one with --imu-topic");
+  }
+  return imus.empty() ? "" : imus.front().name;
+}
+
 std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames,
                                   size_t first) {
   if (stride == 0) throw std::invalid_argument("the stride between played scans must be at least 1");

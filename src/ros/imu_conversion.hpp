@@ -8,13 +8,15 @@
 #include <string>
 
 #include "elo/imu/imu_track.hpp"
+#include "elo/io/bag_imu.hpp"
 
 namespace elo_ros {
 
-// Why an Imu message gives no sample: the keys the node's diagnostics and elo_run count them under.
+// Why an Imu message gives no sample: the core's keys (elo/io/bag_imu.hpp), which a ROS 2 bag's messages
+// are counted under too.
 namespace imu_message {
-inline constexpr char kNoAngularVelocity[] = "Imu message without angular velocity (its covariance[0] is -1)";
-inline constexpr char kUnreadable[] = "Imu message unreadable";
+using elo::imu_message::kNoAngularVelocity;
+using elo::imu_message::kUnreadable;
 }  // namespace imu_message
 
 // The sample an Imu message holds: its header stamp, angular_velocity (rad/s) and linear_acceleration

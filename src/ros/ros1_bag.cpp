@@ -6,7 +6,6 @@
 #include <std_msgs/Header.h>
 
 #include <algorithm>
-#include <iterator>
 #include <map>
 #include <optional>
 
@@ -78,57 +77,32 @@ void openBag(rosbag::Bag& bag, const std::string& path) {
   }
 }
 
-std::string listed(const std::vector<elo::BagTopic>& topics) {
-  std::string text;
-  for (const elo::BagTopic& topic : topics) text += (text.empty() ? "" : ", ") + topic.name + " (" + topic.type + ")";
-  return text;
-}
-
-// `requested` when it is an Imu topic of the bag, else its only one; empty when it has none.
-std::string chooseImuTopic(const std::string& path, const std::vector<elo::BagTopic>& topics,
-                           const std::string& requested) {
-  std::vector<elo::BagTopic> imus;
-  std::copy_if(topics.begin(), topics.end(), std::back_inserter(imus),
-               [](const elo::BagTopic& topic) { return topic.type == ImuType::value(); });
-  if (!requested.empty()) {
-    if (std::none_of(imus.begin(), imus.end(), [&](const elo::BagTopic& t) { return t.name == requested; })) {
-      throw elo::IoError("bag '" + path + "' has no " + ImuType::value() + " topic " + requested + "; its topics: " +
-                         listed(topics));
-    }
-    return requested;
-  }
-  if (imus.size() > 1) {
-    throw elo::IoError("bag '" + path + "' has several " + ImuType::value() + " topics: " + listed(imus) +
-                       "; choose one with --imu-topic");
-  }
-  return imus.empty() ? "" : imus.front().name;
-}
-
 }  // namespace
 
-BagImu readRos1BagImu(const std::string& path, const std::string& topic) {
+elo::BagImu readRos1BagImu(const std::string& path, const std::string& topic) {
   rosbag::Bag bag;
   openBag(bag, path);
-  BagImu imu;
-  imu.topic = chooseImuTopic(path, topicsOf(bag), topic);
+  elo::BagImu imu;
+  imu.topic = elo::chooseImuTopic("bag '" + path + "'", topicsOf(bag), ImuType::value(), topic);
   if (imu.topic.empty()) return imu;
   for (const rosbag::MessageInstance& instance : rosbag::View(bag, rosbag::TopicQuery(imu.topic))) {
     std::string problem;
     std::optional<elo::ImuSample> sample;
     try {
       if (const auto message = instance.instantiate<sensor_msgs::Imu>()) sample = imuSampleOf(*message, problem);
-    } catch (const std::exception&) {
+    } catch (const std::exception& error) {
       // A message cut short or of another layout: counted, as a cloud that cannot be read is skipped.
+      imu.skip(imu_message::kUnreadable, "bag '" + path + "', topic " + imu.topic + ", the message recorded at " +
+                            std::to_string(instance.getTime().toSec()) + " s: " + error.what());
+      continue;
     }
     if (sample) {
       imu.samples.push_back(*sample);
     } else {
-      ++imu.skipped[problem.empty() ? imu_message::kUnreadable : problem];
+      imu.skip(problem.empty() ? imu_message::kUnreadable : problem);
     }
   }
-  // A bag records messages as they arrived; the samples go to the odometry in the order of their stamps.
-  std::stable_sort(imu.samples.begin(), imu.samples.end(),
-                   [](const elo::ImuSample& a, const elo::ImuSample& b) { return a.stamp < b.stamp; });
+  imu.sortByStamp();
   return imu;
 }
 

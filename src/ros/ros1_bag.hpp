@@ -7,11 +7,10 @@
 #include <rosbag/message_instance.h>
 #include <rosbag/view.h>
 
-#include <map>
 #include <string>
 #include <vector>
 
-#include "elo/imu/imu_track.hpp"
+#include "elo/io/bag_imu.hpp"
 #include "elo/io/scan_source.hpp"
 
 namespace elo_ros {
@@ -45,16 +44,9 @@ class Ros1Bag : public elo::ScanSource {
   std::vector<Message> messages_;                  // in stamp order
 };
 
-// The sensor_msgs/Imu messages of a ROS 1 bag, for elo_run's IMU (docs/imu.md).
-struct BagImu {
-  std::string topic;                      // empty: the bag has no Imu topic
-  std::vector<elo::ImuSample> samples;    // in header-stamp order
-  std::map<std::string, size_t> skipped;  // messages that gave no sample, by reason (imu_conversion.hpp)
-};
-
-// Reads the samples of `topic` (empty: the bag's only sensor_msgs/Imu topic; none when it has none).
+// The sensor_msgs/Imu messages of a ROS 1 bag, for elo_run's IMU (docs/imu.md): the samples of `topic` (empty: the bag's only sensor_msgs/Imu topic; none when it has none).
 // Throws elo::IoError for a bag rosbag cannot open, a `topic` that is no Imu topic of the bag (the message
 // lists its topics), or several Imu topics and none named (the message lists them).
-BagImu readRos1BagImu(const std::string& path, const std::string& topic);
+elo::BagImu readRos1BagImu(const std::string& path, const std::string& topic);
 
 }  // namespace elo_ros

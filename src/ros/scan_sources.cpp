@@ -24,25 +24,34 @@ std::unique_ptr<elo::ScanSource> openScanSource(const std::string& input, const 
   return std::make_unique<elo::Sequence>(input);
 }
 
+namespace {
+
+// A bag's Imu topic as elo_run takes it: its samples and skipped messages, or a warning when it has none.
+ImuRecording recordingOf(elo::BagImu bag, const std::string& input, ImuRecording recording) {
+  if (bag.topic.empty()) {
+    recording.warning = "imu.enabled, but bag '" + input + "' has no sensor_msgs/Imu topic: the LiDAR alone";
+    return recording;
+  }
+  recording.samples = std::move(bag.samples);
+  recording.skipped = std::move(bag.skipped);
+  recording.unreadable_detail = std::move(bag.unreadable_detail);
+  recording.describe = "bag '" + input + "', topic " + bag.topic;
+  return recording;
+}
+
+}  // namespace
+
 ImuRecording readImuRecording(const std::string& input, const std::string& imu_topic) {
   ImuRecording recording;
   const std::filesystem::path path(input);
-  if (path.extension() == ".bag") {
-    BagImu bag = readRos1BagImu(input, imu_topic);
-    if (bag.topic.empty()) {
-      recording.warning = "imu.enabled, but bag '" + input + "' has no sensor_msgs/Imu topic: the LiDAR alone";
-      return recording;
-    }
-    recording.samples = std::move(bag.samples);
-    recording.skipped = std::move(bag.skipped);
-    recording.describe = "bag '" + input + "', topic " + bag.topic;
-    return recording;
-  }
-  if (!imu_topic.empty()) throw elo::IoError("--imu-topic names a ROS 1 bag's topic, but '" + input + "' is not one");
+  if (path.extension() == ".bag") return recordingOf(readRos1BagImu(input, imu_topic), input, recording);
   if (path.extension() == ".db3" || elo::isRos2Bag(input)) {
-    recording.warning = "imu.enabled, but elo_run does not read the IMU of a ROS 2 bag: the LiDAR alone";
-    return recording;
+    // A .db3 file is one file of a ROS 2 bag: the bag is its directory, as openScanSource() reads it.
+    const std::string bag = elo::isRos2Bag(input) ? input : std::filesystem::absolute(path).parent_path().string();
+    elo::BagImu imu = elo::readRos2BagImu(bag, imu_topic, recording.warning);
+    return recordingOf(std::move(imu), bag, recording);
   }
+  if (!imu_topic.empty()) throw elo::IoError("--imu-topic names a bag's topic, but '" + input + "' is not a bag");
   const std::filesystem::path file = path / "imu.txt";
   if (!std::filesystem::is_regular_file(file)) {
     throw elo::IoError("imu.enabled, but " + file.string() +

@@ -22,13 +22,14 @@ struct ImuRecording {
   std::vector<elo::ImuSample> samples;
   std::string describe;                   // where they came from; empty when the input has none
   std::map<std::string, size_t> skipped;  // messages that gave no sample, by reason
-  std::string warning;                    // why there are none: the odometry runs on the LiDAR alone
+  std::string unreadable_detail;          // the first message that could not be read: which, and why
+  std::string warning;                    // why there are none (the LiDAR alone), or what part was lost
 };
 
-// From a ROS 1 bag, its sensor_msgs/Imu topic `imu_topic` (empty: its only one; none: a warning); from a
-// directory, its imu.txt. Throws elo::IoError for a directory without imu.txt or with a malformed one, an
-// `imu_topic` with an input that is no ROS 1 bag, or a bag's Imu topics that readRos1BagImu() refuses. A
-// ROS 2 bag's IMU is not read: a warning.
+// From a bag (ROS 1, or ROS 2: a directory with metadata.yaml or one of its .db3 files), its Imu topic
+// `imu_topic` (empty: its only one; none: a warning); from a directory, its imu.txt. Throws elo::IoError
+// for a directory without imu.txt or with a malformed one, an `imu_topic` with an input that is no bag,
+// or a bag's Imu topics that readRos1BagImu() or elo::readRos2BagImu() refuses.
 ImuRecording readImuRecording(const std::string& input, const std::string& imu_topic);
 
 }  // namespace elo_ros

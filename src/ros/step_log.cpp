@@ -46,8 +46,10 @@ void StepLog::logStartSearch(const elo::StartSearchResult& search) {
                    "against %.3f); taken: %.2f m forward, which the scans do not confirm",
                    search.score, search.rival_score, moved.x());
   } else {
-    ROS_INFO_NAMED(name_, "start in motion: %.2f m forward between the first two scans (%d candidates, %.0f ms)",
-                   moved.x(), search.candidates, search.milliseconds);
+    ROS_INFO_NAMED(name_, "start in motion: %.2f m forward between the first two scans (%d candidates%s, %.0f ms)",
+                   moved.x(), search.candidates,
+                   search.rotation == elo::StartRotation::from_gyro ? " around the gyro's rotation" : "",
+                   search.milliseconds);
   }
 }
 

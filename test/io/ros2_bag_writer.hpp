@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "elo/imu/imu_track.hpp"
 #include "elo/io/point_cloud2.hpp"
 #include "elo/types.hpp"
 
@@ -113,6 +114,27 @@ inline std::vector<uint8_t> encodeCdrPointCloud2(const PointCloud& cloud, Stamp 
   writer.write<uint32_t>(static_cast<uint32_t>(data.size()));  // row_step
   writer.writeBytes(data);
   writer.write<uint8_t>(1);  // is_dense
+  return writer.bytes();
+}
+
+// A sensor_msgs/msg/Imu as a driver publishes it: no orientation (orientation_covariance[0] = -1, as
+// REP-145 asks), the covariances zero but `angular_velocity_covariance0` (-1: no angular velocity).
+inline std::vector<uint8_t> encodeCdrImu(const ImuSample& sample, Stamp stamp, bool big_endian = false,
+                                         double angular_velocity_covariance0 = 0.0) {
+  CdrWriter writer(big_endian);
+  writer.write<int32_t>(stamp.sec);
+  writer.write<uint32_t>(stamp.nanosec);
+  writer.writeString("imu");
+  for (double q : {0.0, 0.0, 0.0, 1.0}) writer.write<double>(q);
+  const auto write_covariance = [&](double first) {
+    writer.write<double>(first);
+    for (int i = 1; i < 9; ++i) writer.write<double>(0.0);
+  };
+  write_covariance(-1.0);
+  for (int axis = 0; axis < 3; ++axis) writer.write<double>(sample.angular_velocity[axis]);
+  write_covariance(angular_velocity_covariance0);
+  for (int axis = 0; axis < 3; ++axis) writer.write<double>(sample.specific_force[axis]);
+  write_covariance(0.0);
   return writer.bytes();
 }
 

@@ -1,8 +1,10 @@
 #include "imu_feed.hpp"
 
 #include <cstdio>
+#include <string>
 
 #include "command_line.hpp"
+#include "elo/io/bag_imu.hpp"
 #include "scan_sources.hpp"
 
 namespace elo::tools {
@@ -17,7 +19,11 @@ ImuFeed::ImuFeed(const Options& options, const Config& config)
   if (!recording.warning.empty()) std::fprintf(stderr, "warning: %s\n", recording.warning.c_str());
   if (!recording.describe.empty()) std::printf("imu: %s, %zu samples\n", recording.describe.c_str(), recording.samples.size());
   for (const auto& [reason, count] : recording.skipped) {
-    std::fprintf(stderr, "warning: %zu IMU message%s skipped: %s\n", count, count > 1 ? "s" : "", reason.c_str());
+    std::string line = std::to_string(count) + " IMU message" + (count > 1 ? "s" : "") + " skipped: " + reason;
+    if (reason == elo::imu_message::kUnreadable && !recording.unreadable_detail.empty()) {
+      line += (count > 1 ? " (the first: " : " (") + recording.unreadable_detail + ")";
+    }
+    std::fprintf(stderr, "warning: %s\n", line.c_str());
   }
   samples_ = std::move(recording.samples);
   skipped_ = std::move(recording.skipped);

@@ -42,9 +42,9 @@ writes the poses of the scans before the failure.
 
 options:
   --topic NAME         the bag's cloud topic (default: its only PointCloud2 topic)
-  --imu-topic NAME     with imu.enabled, the ROS 1 bag's sensor_msgs/Imu topic (default: its only one;
-                       none: the LiDAR alone, with a warning). A directory's IMU is its imu.txt
-                       (docs/imu.md)
+  --imu-topic NAME     with imu.enabled, the bag's Imu topic, sensor_msgs/Imu in a ROS 1 bag or
+                       sensor_msgs/msg/Imu in a ROS 2 bag (default: its only one; none: the LiDAR alone,
+                       with a warning). A directory's IMU is its imu.txt (docs/imu.md)
   --config FILE        YAML overrides of the defaults (see config/*.yaml, --dump-config); given again,
                        each file over the ones before (a sensor's, then elo_sim's imu.yaml)
   --mode f2m|f2f       frame-to-model (default) or frame-to-frame

@@ -26,7 +26,8 @@ void writeTimingRow(std::ofstream& csv, size_t index, double stamp, const FrameR
       << r.times.total << ',' << r.registration.iterations << ',' << r.deskew_rounds << ','
       << r.registration.last.nonground.inliers << ',' << r.registration.last.ground.inliers << ','
       << r.registration.weight << ',' << r.registration.degeneracy.eigenvalues[0] << ','
-      << r.registration.degeneracy.describe() << '\n';
+      << r.registration.degeneracy.describe() << ',' << r.start_search.candidates << ','
+      << r.start_search.milliseconds << '\n';
 }
 
 void showProgress(size_t done, size_t total) {
@@ -50,7 +51,8 @@ ScanLoop::ScanLoop(const Options& options, const ScanSource& source, DriveSessio
   timing_.open(options.timing_csv);
   if (!timing_) throw IoError("cannot write " + options.timing_csv);
   timing_ << "frame,stamp,processed,projection_ms,features_ms,registration_ms,model_update_ms,total_ms,"
-             "iterations,deskew_rounds,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate\n";
+             "iterations,deskew_rounds,nonground_inliers,ground_inliers,weight,smallest_eigenvalue,degenerate,"
+             "start_search_candidates,start_search_ms\n";
 }
 
 void ScanLoop::run(const std::vector<PlayedScan>& played) {

@@ -8,15 +8,30 @@
 #include <string>
 #include <vector>
 
+#include "elo/io/bag_imu.hpp"
 #include "elo/io/scan_source.hpp"
 
 namespace elo {
 
-// The message type of ROS 2 clouds, as a bag's topics table names it.
+namespace ros2_bag_detail {
+class File;  // one .db3 file of a bag, open for the whole run
+}  // namespace ros2_bag_detail
+
+// The message types of ROS 2 clouds and IMUs, as a bag's topics table names them.
 inline const char* const kRos2CloudType = "sensor_msgs/msg/PointCloud2";
+inline const char* const kRos2ImuType = "sensor_msgs/msg/Imu";
 
 // True when `path` is a directory holding metadata.yaml: what `ros2 bag record` writes.
 bool isRos2Bag(const std::string& path);
+
+// The sensor_msgs/msg/Imu messages of the ROS 2 bag `directory`, for elo_run's IMU (docs/imu.md): the
+// samples of `topic` (empty: the bag's only Imu topic; none when it has none), decoded by decodeCdrImu().
+// A message that cannot be read (malformed CDR, SQLite cannot give it) or says it has no angular velocity
+// is skipped and counted; a file damaged part-way gives the messages before the damage, and `warning`
+// says so. Throws IoError as the Ros2Bag constructor does for the bag, for a `topic` that is no Imu topic
+// of it (the message lists its topics), several Imu topics and none named (the message lists them), or an
+// Imu topic not serialized as CDR.
+BagImu readRos2BagImu(const std::string& directory, const std::string& topic, std::string& warning);
 
 class Ros2Bag : public ScanSource {
  public:
@@ -36,7 +51,7 @@ class Ros2Bag : public ScanSource {
   std::string warning() const override { return warning_; }
 
  private:
-  class File;
+  using File = ros2_bag_detail::File;
   struct Message {
     size_t file;
     int64_t row;

@@ -66,6 +66,12 @@ struct BagTopic {
 std::string chooseCloudTopic(const std::string& bag, const std::vector<BagTopic>& topics, const std::string& cloud_type,
                              const std::string& requested);
 
+// The topic a bag's Imu messages are read from: `requested` when given (it must be a topic of `imu_type`),
+// else the bag's only topic of `imu_type`; empty when it has none. Throws IoError listing the bag's topics
+// when `requested` is not an Imu topic, and the candidates when there are several and none is requested.
+std::string chooseImuTopic(const std::string& bag, const std::vector<BagTopic>& topics, const std::string& imu_type,
+                           const std::string& requested);
+
 // One scan of a run: which scan, and the stamp the run gives it.
 struct PlayedScan {
   size_t index;

@@ -192,7 +192,8 @@ class Odometry {
   Eigen::Isometry3d initialGuess(double dt, FrameResult& result);
   // The start search (start_search.hpp) for a scan whose motion is unknown: around the motion accepted
   // last carried over `dt` when a refusal made the motion unknown (its reach along x spans a vehicle that
-  // stopped as well as one that drove on); around the identity at a start, when none was accepted.
+  // stopped as well as one that drove on); around the identity at a start, when none was accepted. With
+  // the gyro's rotation over the interval, every candidate takes it and only translations are searched.
   // Recorded in `result.start_search` and counted.
   void searchMotion(double dt, FrameResult& result);
   // The velocity a scan is deskewed under before it is registered: the last registered (the motion
@@ -244,6 +245,10 @@ class Odometry {
   // deskewed scans registered.
   Vector6d registerAgainstDeskewedStart(const PointCloud& cloud, float stamp, const CloudTimes& times, double dt,
                                         const Vector6d& velocity, FrameResult& result);
+  // The first scan of a start had no velocity to place its stamp in its sweep (stamp_in_reference_): its
+  // translation under `velocity`, the motion the next scan registered, and its turn too unless the gyro
+  // turned it.
+  void placeFirstStamp(const Vector6d& velocity);
 
   Config config_;
   std::unique_ptr<Backend> backend_;
@@ -266,6 +271,10 @@ class Odometry {
   PointCloud provisional_cloud_;
   SweepMotion provisional_motion_;
   float provisional_stamp_ = 0.0f;
+  // That first scan was turned by the gyro at each point's time: the turn between its stamp and its
+  // reference instant is the gyro's (in stamp_in_reference_), not the next scan's rate, which misses it by
+  // degrees when a sweep is swung at a changing rate (a start mid-swing).
+  bool provisional_turned_by_gyro_ = false;
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
   double last_since_first_ = 0.0;  // secondsSinceFirst(last_stamp_)

@@ -18,9 +18,16 @@
 
 namespace elo {
 
+// Where the start search's candidates take their rotation from.
+enum class StartRotation {
+  search_yaw,  // the centre's, then turned by every yaw step around the best along x
+  from_gyro,   // the centre's, the gyro's over the interval: no yaw candidates, translations along x only
+};
+
 struct StartSearchResult {
   bool searched = false;
   int candidates = 0;  // candidate motions registered and scored
+  StartRotation rotation = StartRotation::search_yaw;
   // T^{t-1}_t the registration starts from: the winning candidate after its short registration.
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   // The winner's fit: the kernel-weighted share of its non-ground correspondences (fitScore()).
@@ -44,12 +51,15 @@ double fitScore(const NormalEquations& sums, const RegistrationConfig& config);
 
 // Searches the motion of the backend's projected scan against its model, `dt` seconds after the model's
 // scan: candidates every start_search.step metres along x within motion.max_speed * dt either way,
-// then at every yaw step within start_search.max_yaw_rate_deg * dt around the best of those, each
-// registered from a loose kernel for a few Gauss-Newton steps and scored by fitScore() under the final
-// kernel.
+// then (but with the gyro's rotation) at every yaw step within start_search.max_yaw_rate_deg * dt around
+// the best of those, each registered from a loose kernel for a few Gauss-Newton steps and scored by
+// fitScore() under the final kernel.
 // `centre`: the motion the candidates lie around; the identity at a start, the motion last accepted
-// carried over `dt` when the scan's registration from the prior was refused.
+// carried over `dt` when the scan's registration from the prior was refused. `rotation` from_gyro: the
+// centre's rotation is the gyro's, and the search tries translations along x only (a handheld sensor
+// swung at 190 deg/s turns 19 deg a scan, far beyond the yaw candidates' reach).
 StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
-                                    const Eigen::Isometry3d& centre = Eigen::Isometry3d::Identity());
+                                    const Eigen::Isometry3d& centre = Eigen::Isometry3d::Identity(),
+                                    StartRotation rotation = StartRotation::search_yaw);
 
 }  // namespace elo
