@@ -10,7 +10,8 @@
 //   the LiDAR's translation, in its frame at the start:  R^T u dt + R^T g dt^2 / 2 + P - J_p b - (dR r - r)
 //   the IMU's velocity at the end:                        u + g dt + R (V - J_v b)
 // Both are linear in the state; the lever arm's terms (w' x r, w x (w x r)) are in the IMU's own point
-// moving by dR r - r.
+// moving by dR r - r. An interval whose force predicted the registered translation worse than the
+// LiDAR-only prior did is gated (update(), imu.accel_gate): aliased samples would mislead the velocity.
 #pragma once
 
 #include <Eigen/Core>
