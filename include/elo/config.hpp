@@ -295,6 +295,12 @@ struct ImuConfig {
   // s: the accelerometers' bias is then estimated online against the LiDAR's registered translations, as
   // a random walk that may move by its prior (0.1 m/s^2) over about this long. 0 keeps imu.accel_bias.
   double accel_bias_time_constant = 100.0;
+  // m: the gate on an interval's specific force. When the accelerometers' translation missed the registered
+  // one by more than the LiDAR-only prior's did, plus this, the interval's samples are taken to mislead
+  // (an impulse aliased into one sample, which a unit's anti-aliasing filter would have smoothed): the
+  // filter does not take them, and the next scans' prior is the LiDAR's until the velocity is registered
+  // again. The registrations' own noise stays within it (docs/imu.md, "The accelerometers").
+  double accel_gate = 0.005;
 };
 
 struct Config {

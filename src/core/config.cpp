@@ -261,6 +261,9 @@ std::vector<Parameter> parameters(Config& c) {
                 "m/s^2: the accelerometers' bias in the IMU's axes at the start, [x, y, z]"),
       bindField("imu.accel_bias_time_constant", c.imu.accel_bias_time_constant,
                 "s: the accelerometers' bias estimated online against the registered translations; 0: fixed"),
+      bindField("imu.accel_gate", c.imu.accel_gate,
+                "m: an interval's specific force not taken when its translation missed the registered one by "
+                "more than the LiDAR-only prior's did, plus this"),
   };
 }
 
@@ -388,6 +391,7 @@ void validate(const Config& c) {
   require(imu.accel_limit > 0.0, "imu.accel_limit", "must be positive");
   require(imu.accel_bias.size() == 3, "imu.accel_bias", "must list 3 numbers: x, y, z");
   require(imu.accel_bias_time_constant >= 0.0, "imu.accel_bias_time_constant", "must not be negative");
+  require(imu.accel_gate >= 0.0, "imu.accel_gate", "must not be negative");
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

@@ -124,6 +124,8 @@ Eigen::Isometry3d Odometry::initialGuess(double dt, FrameResult& result) {
     searchMotion(dt, result);
     guess = result.start_search.motion;
   }
+  lidar_prior_translation_.reset();
+  if (motion_.known()) lidar_prior_translation_ = guess.translation();
   if (gyro_.known) guess.linear() = gyro_.rotation;
   if (motion_.known() && inertialPriorKnown()) {
     guess.translation() = inertialTranslation();
@@ -139,7 +141,7 @@ bool Odometry::preintegrateInterval(double previous_reference, double reference)
 void Odometry::followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta) {
   if (!config_.imu.accelerometer) return;
   if (gyro_.known && inertial_interval_known_) {
-    inertial_.update(inertial_interval_, attitude, reference_delta);
+    if (!inertial_.update(inertial_interval_, attitude, reference_delta, lidar_prior_translation_)) ++accel_gated_;
   } else {
     inertial_.forgetVelocity();
   }
@@ -178,6 +180,7 @@ ImuStatus Odometry::imuStatus() const {
   status.gravity_known = inertial_.started();
   status.gravity = inertial_.gravity();
   status.accel_bias = imu_.accelBiasSet() + inertial_.learntBias();
+  status.accel_gated = accel_gated_;
   return status;
 }
 

@@ -236,6 +236,7 @@ void ImuStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("gyro bias (deg/s)", degreesPerSecond(core_.gyro_bias));
   status.add("gravity in the odometry frame (m/s^2)", core_.gravity_known ? vectorText(core_.gravity) : "not estimated yet");
   status.add("accelerometer bias (m/s^2)", vectorText(core_.accel_bias));
+  status.add("accelerometer intervals gated", core_.accel_gated);
 
   reported_fallbacks_ = fallbacks;
   reported_dropped_ = dropped;

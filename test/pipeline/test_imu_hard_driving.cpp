@@ -47,6 +47,7 @@ struct DriveRun {
   std::vector<Eigen::Isometry3d> estimate;
   size_t skipped = 0;
   size_t refused = 0;
+  size_t accel_gated = 0;  // intervals whose specific force the accelerometers' gate left out
 };
 
 // The drive through `config`, each scan after the IMU samples up to the end of its sweep.
@@ -64,6 +65,7 @@ DriveRun drive(const sim::Simulation& simulation, const std::vector<ImuSample>& 
     run.truth.push_back(origin.inverse() * simulation.sensorPose(frame));
     run.estimate.push_back(result.pose);
   }
+  run.accel_gated = odometry.accelGatedCount();
   return run;
 }
 
@@ -100,10 +102,10 @@ TEST_P(ImuHardDriving, TheImuKeepsTheTargets) {
   const DriveRun gyro_run = drive(simulation, samples, gyro);
   const DriveRun imu_run = drive(simulation, samples, accelerometers);
   std::printf("[ hard car ] %s: t_rel over 10 m %.4f %% (LiDAR only %.4f %%, gyro alone %.4f %%); worst turn "
-              "error over 10 scans %.3f deg (LiDAR only %.3f deg); refused %zu (LiDAR only %zu)\n",
+              "error over 10 scans %.3f deg (LiDAR only %.3f deg); refused %zu (LiDAR only %zu); %zu intervals gated\n",
               hard.name.c_str(), tRelOver10m(imu_run), tRelOver10m(lidar_run), tRelOver10m(gyro_run),
               worstTurnErrorOver10Scans(imu_run), worstTurnErrorOver10Scans(lidar_run), imu_run.refused,
-              lidar_run.refused);
+              lidar_run.refused, imu_run.accel_gated);
   for (const DriveRun* run : {&gyro_run, &imu_run}) {
     EXPECT_EQ(run->skipped, 0u);
     EXPECT_EQ(run->refused, 0u);

@@ -168,10 +168,14 @@ TEST(RosDiagnostics, ImuAtItsRateIsOkAndSilenceSlownessAndFallbacksWarn) {
   core.gravity_known = true;
   core.gravity = {0.0, -0.5, -9.79};
   core.accel_bias = {0.05, 0.0, -0.02};
+  core.accel_gated = 3;
   statistics.update(core);
   const diagnostic_updater::DiagnosticStatusWrapper started = imuStatusAfter(statistics, 201, 0.005);
   EXPECT_EQ(valueOf(started, "gravity in the odometry frame (m/s^2)"), "0, -0.5, -9.79");
   EXPECT_EQ(valueOf(started, "accelerometer bias (m/s^2)"), "0.05, 0, -0.02");
+  // The gate's intervals are counted, not warned of: the prior is the LiDAR's over them, as designed.
+  EXPECT_EQ(valueOf(started, "accelerometer intervals gated"), "3");
+  EXPECT_EQ(started.level, diagnostic_msgs::DiagnosticStatus::OK) << started.message;
   EXPECT_EQ(valueOf(steady, "scans on the LiDAR-only prior"), "0");
 
   const diagnostic_updater::DiagnosticStatusWrapper silent = imuStatusAfter(statistics, 0, 0.005);

@@ -38,7 +38,8 @@ void printTrackingHealth(const Odometry& odometry) {
   if (odometry.lost()) std::printf(", LOST at the end (the last registration was refused)");
 }
 
-// With imu.enabled: the scans the gyro could not turn and the samples dropped, by reason.
+// With imu.enabled: the scans the gyro could not turn and the samples dropped, by reason; the intervals
+// whose specific force the accelerometers' gate left out.
 void printImuHealth(const Odometry& odometry) {
   if (!odometry.config().imu.enabled) return;
   size_t fallbacks = 0;
@@ -49,6 +50,10 @@ void printImuHealth(const Odometry& odometry) {
   if (fallbacks == 0) std::printf(", every scan turned by the IMU");
   for (const auto& [reason, count] : odometry.imuDroppedCounts()) {
     std::printf(", %zu IMU sample%s dropped (%s)", count, count > 1 ? "s" : "", reason.c_str());
+  }
+  if (odometry.accelGatedCount() > 0) {
+    std::printf(", %zu interval%s specific force gated (imu.accel_gate)", odometry.accelGatedCount(),
+                odometry.accelGatedCount() > 1 ? "s'" : "'s");
   }
 }
 

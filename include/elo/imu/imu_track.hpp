@@ -46,6 +46,9 @@ struct ImuStatus {
   bool gravity_known = false;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();
+  // Intervals whose specific force the filter did not take, their translation missing the registered one
+  // (imu.accel_gate): the scans after each on the LiDAR's translation until the velocity is registered again.
+  size_t accel_gated = 0;
 };
 
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference

@@ -10,10 +10,12 @@
 //   the LiDAR's translation, in its frame at the start:  R^T u dt + R^T g dt^2 / 2 + P - J_p b - (dR r - r)
 //   the IMU's velocity at the end:                        u + g dt + R (V - J_v b)
 // Both are linear in the state; the lever arm's terms (w' x r, w x (w x r)) are in the IMU's own point
-// moving by dR r - r.
+// moving by dR r - r. An interval whose force predicted the registered translation worse than the
+// LiDAR-only prior did is gated (update(), imu.accel_gate): aliased samples would mislead the velocity.
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "elo/config.hpp"
 #include "elo/imu/imu_track.hpp"
@@ -38,7 +40,13 @@ class InertialFilter {
   // The LiDAR registered `registered` over `motion` (starting at `attitude`): the state is corrected by
   // its translation, then carried to the interval's end. The first call starts the filter: gravity is
   // taken as the mean specific force over the interval, loosely (the sensor may be accelerating).
-  void update(const Preintegration& motion, const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& registered);
+  // The gate (imu.accel_gate): once a registration gave the velocity, an interval whose predicted
+  // translation misses `registered` by more than `lidar_prior` (the LiDAR-only prior's translation, when
+  // there was one) did, plus the margin, is not taken: its force is taken to mislead (an aliased sample),
+  // the velocity is forgotten and the filter is not ready() again until two registrations gave it. False
+  // when the interval was gated.
+  bool update(const Preintegration& motion, const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& registered,
+              const std::optional<Eigen::Vector3d>& lidar_prior = std::nullopt);
   // Carries the state over `motion` without a registration.
   void propagate(const Preintegration& motion, const Eigen::Matrix3d& attitude);
   // The velocity becomes unknown (the IMU could not cover an interval); gravity and the bias stay.
@@ -55,10 +63,14 @@ class InertialFilter {
   using Vector9d = Eigen::Matrix<double, 9, 1>;
   using Matrix9d = Eigen::Matrix<double, 9, 9>;
   void start(const Preintegration& motion, const Eigen::Matrix3d& attitude);
+  // Whether the interval's innovation (the registered translation less the predicted one) is gated.
+  bool disagrees(const Eigen::Vector3d& innovation, const Eigen::Isometry3d& registered,
+                 const std::optional<Eigen::Vector3d>& lidar_prior) const;
 
   Eigen::Vector3d lever_;            // the IMU's origin in the LiDAR frame, m
   Eigen::Matrix3d lidar_from_imu_;
   double bias_walk_;                 // (m/s^2)^2 per second of the bias's random walk; 0: fixed
+  double gate_margin_;               // m, imu.accel_gate
   bool started_ = false;
   static constexpr int kUpdatesForVelocity = 2;
   int velocity_updates_ = 0;  // registrations since the velocity was unknown

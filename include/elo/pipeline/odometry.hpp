@@ -140,6 +140,9 @@ class Odometry {
   // dropped, by reason.
   const std::map<std::string, size_t>& imuFallbackCounts() const { return imu_fallbacks_; }
   const std::map<std::string, size_t>& imuDroppedCounts() const { return imu_.droppedCounts(); }
+  // With imu.accelerometer: the intervals whose specific force the inertial filter did not take, their
+  // translation missing the registered one (imu.accel_gate).
+  size_t accelGatedCount() const { return accel_gated_; }
   // The IMU's state in one struct, for the node's diagnostics.
   ImuStatus imuStatus() const;
   // With imu.accelerometer: gravity in the odometry's world frame (the first scan's), the IMU's velocity
@@ -299,6 +302,10 @@ class Odometry {
   InertialFilter inertial_;
   Preintegration inertial_interval_;  // of the scan being processed, since the last accepted one
   bool inertial_interval_known_ = false;
+  // The LiDAR-only prior's translation for the scan being processed, when the motion model had one: the
+  // accelerometers' gate measures their miss against its.
+  std::optional<Eigen::Vector3d> lidar_prior_translation_;
+  size_t accel_gated_ = 0;
   std::map<std::string, size_t> imu_fallbacks_;
 };
 

@@ -26,7 +26,8 @@ Eigen::Vector3d vectorOf(const std::vector<double>& values) { return {values[0],
 
 InertialFilter::InertialFilter(const ImuConfig& config)
     : bias_walk_(config.accel_bias_time_constant > 0.0 ? kBiasPrior * kBiasPrior / config.accel_bias_time_constant
-                                                        : 0.0) {
+                                                        : 0.0),
+      gate_margin_(config.accel_gate) {
   setMount(config);
 }
 
@@ -59,9 +60,9 @@ void InertialFilter::start(const Preintegration& motion, const Eigen::Matrix3d& 
   velocity_updates_ = 0;
 }
 
-void InertialFilter::update(const Preintegration& motion, const Eigen::Matrix3d& attitude,
-                            const Eigen::Isometry3d& registered) {
-  if (!(motion.duration > 0.0)) return;
+bool InertialFilter::update(const Preintegration& motion, const Eigen::Matrix3d& attitude,
+                            const Eigen::Isometry3d& registered, const std::optional<Eigen::Vector3d>& lidar_prior) {
+  if (!(motion.duration > 0.0)) return true;
   if (!started_) start(motion, attitude);
   const double dt = motion.duration;
   // The registered translation as a measurement of R^T u dt + R^T g dt^2 / 2 - J_p b.
@@ -70,6 +71,13 @@ void InertialFilter::update(const Preintegration& motion, const Eigen::Matrix3d&
   Eigen::Matrix<double, 3, 9> h;
   h << attitude.transpose() * dt, 0.5 * dt * dt * attitude.transpose(), -motion.position_by_bias;
   const Eigen::Vector3d innovation = measured - h * state_;
+  if (disagrees(innovation, registered, lidar_prior)) {
+    // The interval's force misled the velocity it carries on: gravity and the bias are carried over the
+    // interval, the velocity is measured again from the registrations that follow.
+    propagate(motion, attitude);
+    forgetVelocity();
+    return false;
+  }
   const Eigen::Matrix3d s =
       h * covariance_ * h.transpose() + Eigen::Matrix3d::Identity() * kRegisteredTranslationSigma * kRegisteredTranslationSigma;
   const Eigen::Matrix<double, 9, 3> gain = covariance_ * h.transpose() * s.inverse();
@@ -79,6 +87,14 @@ void InertialFilter::update(const Preintegration& motion, const Eigen::Matrix3d&
                 gain * gain.transpose() * kRegisteredTranslationSigma * kRegisteredTranslationSigma;
   ++velocity_updates_;
   propagate(motion, attitude);
+  return true;
+}
+
+bool InertialFilter::disagrees(const Eigen::Vector3d& innovation, const Eigen::Isometry3d& registered,
+                               const std::optional<Eigen::Vector3d>& lidar_prior) const {
+  // Without a velocity from a registration before, the innovation is the velocity's, not the force's.
+  if (velocity_updates_ == 0 || !lidar_prior) return false;
+  return innovation.norm() > (registered.translation() - *lidar_prior).norm() + gate_margin_;
 }
 
 void InertialFilter::propagate(const Preintegration& motion, const Eigen::Matrix3d& attitude) {
