@@ -253,7 +253,6 @@ Vector6d Odometry::registerAgainstDeskewedStart(const PointCloud& cloud, float s
   extractFeatures();
   backend_->updateModel(Eigen::Isometry3d::Identity(), provisional_stamp_);
   model_provisional_ = false;
-  provisional_cloud_ = PointCloud();
   // This scan, deskewed under the same motion, registered against it from where the two bent scans met.
   Vector6d deskewed_under = velocity;
   projectDeskewed(cloud, stamp, times, deskewed_under, result);
@@ -432,6 +431,8 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     provisional_cloud_ = cloud;
     provisional_motion_ = {times.source, Vector6d::Zero(), times.reference, gyro_.sweep};
     provisional_stamp_ = relative_stamp;
+  } else {
+    provisional_cloud_ = PointCloud();  // its memory back once the start is over
   }
   provisional_turned_by_gyro_ = model_provisional_ && gyro_.known;
   // The first scan of a start turned by the gyro: its stamp's turn in its reference frame is the gyro's.
