@@ -12,8 +12,12 @@
 #include "elo/io/ros2_bag.hpp"
 #include "ros2_bag_writer.hpp"
 #include "temp_directory.hpp"
+#include "test_helpers.hpp"
 
 namespace {
+
+using elo::test::contains;
+using elo::test::errorOf;
 
 // sensor_msgs/msg/Imu with frame_id "imu_link" (9 bytes with its NUL), byte offsets from the buffer's
 // start: the 4-byte encapsulation header, then header.stamp (sec at 4, nanosec at 8), the frame_id's length
@@ -50,17 +54,6 @@ std::vector<uint8_t> handBuiltImu(bool big_endian, double angular_velocity_covar
   put<double>(bytes, kAngularVelocityCovariance, angular_velocity_covariance0, big_endian);
   return bytes;
 }
-
-std::string errorOf(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const elo::IoError& error) {
-    return error.what();
-  }
-  return "";
-}
-
-bool contains(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
 
 TEST(CdrImu, DecodesAHandBuiltMessageExactlyInEitherByteOrder) {
   for (const bool big_endian : {false, true}) {

@@ -13,10 +13,13 @@
 #include "elo/io/ros2_bag.hpp"
 #include "ros2_bag_writer.hpp"
 #include "temp_directory.hpp"
+#include "test_helpers.hpp"
 
 namespace {
 
+using elo::test::contains;
 using elo::test::encodeCdrPointCloud2;
+using elo::test::errorOf;
 using elo::test::Ros2BagWriter;
 using elo::test::stampOf;
 
@@ -28,17 +31,6 @@ elo::PointCloud smallCloud(float offset = 0.0f) {
   cloud.time = {-0.05f, 0.0f, 0.049f};
   return cloud;
 }
-
-std::string errorOf(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const elo::IoError& error) {
-    return error.what();
-  }
-  return "";
-}
-
-bool contains(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
 
 TEST(CdrPointCloud2, DecodesWhatTheEncoderWritesInEitherByteOrder) {
   const elo::PointCloud cloud = smallCloud();

@@ -9,6 +9,8 @@
 #include <random>
 #include <string>
 
+#include "../text_contains.hpp"
+#include "elo/io/io_error.hpp"
 #include "elo/types.hpp"
 
 namespace elo::test {
@@ -25,6 +27,16 @@ void expectThrowContaining(const std::function<void()>& action, std::initializer
           << "message '" << error.what() << "' does not contain '" << fragment << "'";
     }
   }
+}
+
+// The message of the IoError `action` throws; empty when it throws none.
+inline std::string errorOf(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const IoError& error) {
+    return error.what();
+  }
+  return "";
 }
 
 inline void writeText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "../text_contains.hpp"
+
 namespace elo::test {
 
 struct CommandResult {
@@ -22,10 +24,6 @@ inline CommandResult runCommand(const std::string& command) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
-}
-
-inline bool contains(const std::string& text, const std::string& fragment) {
-  return text.find(fragment) != std::string::npos;
 }
 
 }  // namespace elo::test
