@@ -125,6 +125,13 @@ class EloRunCli : public testing::Test {
     return runEloRunOn(sequence_.string(), poses(), options);
   }
   std::string poses() const { return directory_.file("poses.txt"); }
+  // elo_sim's 6-scan urban drive with a consumer IMU (imu.txt and imu.yaml beside the scans) in
+  // `imu_drive`, with `more` of elo_sim's options.
+  CommandResult simulateImuDrive(const std::string& more = "") const {
+    return runCommand(std::string(ELO_SIM_TOOL) +
+                      " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 --threads 2 "
+                      "--imu consumer --output " + directory_.file("imu_drive") + more);
+  }
 
   static elo::test::TempDirectory* drive_;
   static std::vector<std::string> intact_poses_;
@@ -478,9 +485,7 @@ TEST_F(EloRunCli, MapIsWrittenAtTheEndAndWhenTheRunFailsPartWay) {
 // imu.enabled and no imu.txt it stops, saying where it looked.
 TEST_F(EloRunCli, ImuTxtBesideTheScansTurnsEveryScan) {
   const std::string drive = directory_.file("imu_drive");
-  const CommandResult simulated = runCommand(std::string(ELO_SIM_TOOL) +
-                                             " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 "
-                                             "--threads 2 --imu consumer --output " + drive);
+  const CommandResult simulated = simulateImuDrive();
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   ASSERT_TRUE(fs::is_regular_file(drive + "/imu.txt"));
   const CommandResult with_imu = runEloRunOn(drive, poses(), "--config " + drive + "/imu.yaml");
@@ -515,9 +520,7 @@ double largestDifference(const std::string& a, const std::string& b) {
 TEST_F(EloRunCli, ImuTopicOfABagGivesThePosesOfTheSameDrivesImuTxt) {
   const std::string drive = directory_.file("imu_drive");
   const std::string bag = directory_.file("imu_drive.bag");
-  const CommandResult simulated = runCommand(std::string(ELO_SIM_TOOL) +
-                                             " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 "
-                                             "--threads 2 --format pcd --imu consumer --output " + drive + " --bag " + bag);
+  const CommandResult simulated = simulateImuDrive(" --format pcd --bag " + bag);
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   const std::string imu_yaml = "--config " + drive + "/imu.yaml";
   const CommandResult from_file = runEloRunOn(drive, directory_.file("from_file.txt"), imu_yaml);
@@ -584,9 +587,7 @@ TEST_F(EloRunCli, BagWithTwoImuTopicsNeedsImuTopicAndSkipsAMalformedMessage) {
 // saying what is wrong; unnamed, the run stops naming both topics.
 TEST_F(EloRunCli, Ros2BagImuTopicGivesTheRos1BagsPosesBitForBit) {
   const std::string drive = directory_.file("imu_drive");
-  const CommandResult simulated = runCommand(std::string(ELO_SIM_TOOL) +
-                                             " --world urban --trajectory curves --sensor hdl64 --seed 3 --frames 6 "
-                                             "--threads 2 --imu consumer --output " + drive);
+  const CommandResult simulated = simulateImuDrive();
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   const elo::Sequence sequence(drive);
   const std::vector<elo::ImuSample> samples = elo::readImuFile(drive + "/imu.txt");
