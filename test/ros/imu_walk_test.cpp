@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "rostest_helpers.hpp"
 
@@ -44,6 +45,23 @@ class ImuDiagnostics {
     return statuses_;
   }
 
+  // The first status after the `after` first ones that `wanted` accepts, waiting for it up to the timeout:
+  // the node reports once a second on a wall timer, which a loaded machine runs late.
+  template <typename Predicate>
+  std::optional<diagnostic_msgs::DiagnosticStatus> waitFor(size_t after, Predicate wanted, double timeout_seconds) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_seconds);
+    for (;;) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (size_t i = after; i < statuses_.size(); ++i) {
+          if (wanted(statuses_[i])) return statuses_[i];
+        }
+      }
+      if (ros::WallTime::now() > deadline) return std::nullopt;
+      ros::WallDuration(0.05).sleep();
+    }
+  }
+
  private:
   void onArray(const diagnostic_msgs::DiagnosticArray& array) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -66,6 +84,13 @@ std::string valueOf(const diagnostic_msgs::DiagnosticStatus& status, const std::
     if (entry.key == key) return entry.value;
   }
   return "<missing>";
+}
+
+// Its values, a line each, for a failure's message.
+std::string describe(const diagnostic_msgs::DiagnosticStatus& status) {
+  std::string text;
+  for (const auto& entry : status.values) text += "\n  " + entry.key + ": " + entry.value;
+  return text;
 }
 
 double rotationDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -134,8 +159,16 @@ TEST_F(ImuWalk, TheNodeletTracksTheSwungWalkAndTheNodeWithoutImuMessagesWarns) {
   const size_t before_last_scan = play(clouds.size(), walk_imu, {&walk_points, &silent_points});
   ASSERT_TRUE(walk.waitFor(clouds.size(), 90.0)) << "got " << walk.messages().size() << " odometry messages";
   ASSERT_TRUE(silent.waitFor(clouds.size(), 90.0)) << "got " << silent.messages().size() << " odometry messages";
+  const size_t reported_during_walk = walk_diagnostics.statuses().size();
   for (size_t next = before_last_scan; next < imu.size(); ++next) walk_imu.publish(imu[next]);
-  ros::WallDuration(2.5).sleep();  // the diagnostics of the last scans' window, once a second
+  // The walk over: a status that has every message and then a second without one.
+  const std::string all_received = std::to_string(imu.size());
+  const auto walk_last = walk_diagnostics.waitFor(
+      reported_during_walk,
+      [&](const auto& status) {
+        return valueOf(status, "Imu messages received") == all_received && status.message.find("IMU silent") != std::string::npos;
+      },
+      10.0);
 
   const std::vector<nav_msgs::Odometry> tracked = walk.messages();
   ASSERT_EQ(tracked.size(), clouds.size());
@@ -157,27 +190,33 @@ TEST_F(ImuWalk, TheNodeletTracksTheSwungWalkAndTheNodeWithoutImuMessagesWarns) {
     return status.level == diagnostic_msgs::DiagnosticStatus::OK && rate > 150.0 && rate < 250.0;
   });
   EXPECT_TRUE(rate_seen) << "no OK status at 200 Hz during the walk; the last: " << walk_statuses.back().message;
-  const auto& walk_last = walk_statuses.back();
-  std::string walk_values;
-  for (const auto& entry : walk_last.values) walk_values += "\n  " + entry.key + ": " + entry.value;
-  EXPECT_EQ(valueOf(walk_last, "scans on the LiDAR-only prior"), "0") << walk_values;
-  EXPECT_EQ(valueOf(walk_last, "Imu messages received"), std::to_string(imu.size()));
-  EXPECT_EQ(valueOf(walk_last, "IMU samples taken"), std::to_string(before_last_scan)) << walk_values;
-  EXPECT_NE(valueOf(walk_last, "gyro bias (deg/s)"), "<missing>");
-  EXPECT_NE(walk_last.message.find("IMU silent"), std::string::npos) << "the walk over, the IMU is silent";
+  ASSERT_TRUE(walk_last) << "no status with all " << all_received << " Imu messages and the IMU silent since; the last: "
+                         << walk_statuses.back().message << describe(walk_statuses.back());
+  EXPECT_EQ(valueOf(*walk_last, "scans on the LiDAR-only prior"), "0") << describe(*walk_last);
+  // The last scan waits for the first sample at or past its sweep's end: the one after it, sent with the
+  // scan, may reach the nodelet after the scan's counts were taken.
+  const double last_sweep_end = (clouds.back()->header.stamp + ros::Duration(kSweep / 2)).toSec() - 1e-6;
+  const size_t needed = 1 + std::count_if(imu.begin(), imu.end(), [&](const sensor_msgs::Imu& sample) {
+                          return sample.header.stamp.toSec() < last_sweep_end;
+                        });
+  const size_t taken = std::stoul(valueOf(*walk_last, "IMU samples taken"));
+  EXPECT_GE(taken, needed) << describe(*walk_last);
+  EXPECT_LE(taken, before_last_scan) << describe(*walk_last);
+  EXPECT_NE(valueOf(*walk_last, "gyro bias (deg/s)"), "<missing>");
 
   EXPECT_EQ(silent.messages().size(), clouds.size()) << "every scan gets a pose without the IMU";
+  const std::string every_scan = std::to_string(clouds.size());
+  const auto silent_last = silent_diagnostics.waitFor(
+      0, [&](const auto& status) { return valueOf(status, "scans on the LiDAR-only prior") == every_scan; }, 10.0);
   const auto silent_statuses = silent_diagnostics.statuses();
   ASSERT_FALSE(silent_statuses.empty()) << "no imu status from the node";
   for (const auto& status : silent_statuses) {
     EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN) << status.message;
     EXPECT_NE(status.message.find("IMU silent"), std::string::npos) << status.message;
   }
-  const auto& silent_last = silent_statuses.back();
-  EXPECT_EQ(valueOf(silent_last, "scans on the LiDAR-only prior"), std::to_string(clouds.size()));
-  EXPECT_EQ(valueOf(silent_last, "scans on the LiDAR-only prior: no IMU samples over the scan"),
-            std::to_string(clouds.size()));
-  EXPECT_EQ(valueOf(silent_last, "Imu messages received"), "0");
+  ASSERT_TRUE(silent_last) << "no status with every scan on the LiDAR-only prior; the last:" << describe(silent_statuses.back());
+  EXPECT_EQ(valueOf(*silent_last, "scans on the LiDAR-only prior: no IMU samples over the scan"), every_scan);
+  EXPECT_EQ(valueOf(*silent_last, "Imu messages received"), "0");
 }
 
 // TF has no transform from the Imu messages' frame to the clouds': the node warns, leaves the samples
@@ -195,15 +234,15 @@ TEST_F(ImuWalk, WithoutTheMountInTfTheSamplesAreUnusedAndEveryScanFallsBack) {
   ASSERT_TRUE(waitForSubscribers(imu_topic, 10.0)) << "the node does not listen to its imu topic";
   play(kScans, imu_topic, {&points});
   ASSERT_TRUE(recorder.waitFor(kScans, 60.0)) << "got " << recorder.messages().size() << " odometry messages";
-  ros::WallDuration(2.5).sleep();
-
+  const std::string every_scan = std::to_string(kScans);
+  const auto last = diagnostics.waitFor(
+      0, [&](const auto& status) { return valueOf(status, "scans on the LiDAR-only prior") == every_scan; }, 10.0);
   const auto statuses = diagnostics.statuses();
   ASSERT_FALSE(statuses.empty()) << "no imu status from the node";
-  const auto& last = statuses.back();
-  EXPECT_EQ(last.level, diagnostic_msgs::DiagnosticStatus::WARN) << last.message;
-  EXPECT_EQ(valueOf(last, "IMU samples taken"), "0");
-  EXPECT_EQ(valueOf(last, "scans on the LiDAR-only prior"), std::to_string(kScans));
-  const std::string unused = valueOf(last, "Imu messages unused: no IMU -> LiDAR transform from TF");
+  ASSERT_TRUE(last) << "no status with every scan on the LiDAR-only prior; the last:" << describe(statuses.back());
+  EXPECT_EQ(last->level, diagnostic_msgs::DiagnosticStatus::WARN) << last->message;
+  EXPECT_EQ(valueOf(*last, "IMU samples taken"), "0");
+  const std::string unused = valueOf(*last, "Imu messages unused: no IMU -> LiDAR transform from TF");
   ASSERT_NE(unused, "<missing>");
   EXPECT_GT(std::stoul(unused), 100u) << "a 200 Hz IMU over 2 s, its last second held";
 }
