@@ -301,6 +301,11 @@ struct ImuConfig {
   // filter does not take them, and the next scans' prior is the LiDAR's until the velocity is registered
   // again. The registrations' own noise stays within it (docs/imu.md, "The accelerometers").
   double accel_gate = 0.005;
+  // deg: roll and pitch held to gravity (docs/imu.md, TiltHold). The accelerometers' gravity over the
+  // first ten seconds is the reference; when a later ten seconds' turns further than this from it, the
+  // attitude is turned back to this, a share each scan. Above what a consumer unit's bias fakes on the
+  // simulated drives (0.55 deg at most; an industrial unit's 0.3 deg). 0 turns the hold off.
+  double tilt_hold_deg = 1.0;
 };
 
 struct Config {

@@ -264,6 +264,9 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("imu.accel_gate", c.imu.accel_gate,
                 "m: an interval's specific force not taken when its translation missed the registered one by "
                 "more than the LiDAR-only prior's did, plus this"),
+      bindField("imu.tilt_hold_deg", c.imu.tilt_hold_deg,
+                "deg: roll and pitch turned back towards gravity when the accelerometers' gravity is further than "
+                "this from where it was once known; 0: off"),
   };
 }
 
@@ -392,6 +395,7 @@ void validate(const Config& c) {
   require(imu.accel_bias.size() == 3, "imu.accel_bias", "must list 3 numbers: x, y, z");
   require(imu.accel_bias_time_constant >= 0.0, "imu.accel_bias_time_constant", "must not be negative");
   require(imu.accel_gate >= 0.0, "imu.accel_gate", "must not be negative");
+  require(imu.tilt_hold_deg >= 0.0 && imu.tilt_hold_deg < 90.0, "imu.tilt_hold_deg", "must be in [0, 90)");
 }
 
 void setFromString(const Parameter& parameter, const std::string& text) {

@@ -16,7 +16,8 @@ Odometry::Odometry(const Config& config)
       guard_(config),
       height_check_(config.ground.sensor_height),
       imu_(config.imu),
-      inertial_(config.imu) {
+      inertial_(config.imu),
+      tilt_hold_(config.imu) {
   validate(config_);
   backend_ = makeBackend(config_, &backend_warning_);
 }
@@ -33,6 +34,7 @@ void Odometry::restartModel() {
 void Odometry::reset() {
   restartModel();
   inertial_.reset();
+  tilt_hold_.reset();
   pose_ = Eigen::Isometry3d::Identity();
   stamp_in_reference_ = Eigen::Isometry3d::Identity();
 }
@@ -147,6 +149,17 @@ void Odometry::followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isom
   }
 }
 
+void Odometry::holdTilt(const Eigen::Matrix3d& attitude_before, double reference_time) {
+  if (!config_.imu.accelerometer) return;
+  std::optional<Eigen::Vector3d> force;
+  if (gyro_.known && inertial_interval_known_) force = inertial_.worldForce(inertial_interval_, attitude_before);
+  const Eigen::Vector3d imu_position = modelPose() * Eigen::Map<const Eigen::Vector3d>(config_.imu.position.data());
+  const Eigen::Matrix3d turn = tilt_hold_.follow(reference_time, imu_position, force);
+  if (turn.isIdentity(0.0)) return;
+  pose_.linear() = turn * pose_.linear();
+  inertial_.turnWorld(turn);
+}
+
 GyroMotion Odometry::gyroMotion(double stamp, const CloudTimes& times, FrameResult& result) {
   if (!config_.imu.enabled) return {};
   const double reference = stamp + times.reference;
@@ -169,6 +182,7 @@ void Odometry::setImuMount(const std::vector<double>& position, const std::vecto
   config_ = std::move(mounted);
   imu_.setMount(config_.imu);
   inertial_.setMount(config_.imu);
+  tilt_hold_.reset();
 }
 
 ImuStatus Odometry::imuStatus() const {
@@ -181,6 +195,8 @@ ImuStatus Odometry::imuStatus() const {
   status.gravity = inertial_.gravity();
   status.accel_bias = imu_.accelBiasSet() + inertial_.learntBias();
   status.accel_gated = accel_gated_;
+  status.tilt_deg = tilt_hold_.tiltDeg();
+  status.tilt_held = tilt_hold_.heldCount();
   return status;
 }
 
@@ -416,8 +432,10 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
       }
     } else {
       reference_delta = result.registration.model_from_scan;
-      if (config_.imu.enabled) followInertial(modelPose().linear(), reference_delta);
+      const Eigen::Matrix3d attitude_before = modelPose().linear();
+      if (config_.imu.enabled) followInertial(attitude_before, reference_delta);
       stamp_in_reference = acceptRegistration(reference_delta, dt, deskewed_under, times, result);
+      if (config_.imu.enabled) holdTilt(attitude_before, since_first + times.reference);
       if (gyro_.known && result.registration.converged && !result.registration.degeneracy.any()) {
         imu_.learnBias(gyro_.rotation, reference_delta.linear(), dt);
       }

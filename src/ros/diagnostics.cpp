@@ -237,6 +237,10 @@ void ImuStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("gravity in the odometry frame (m/s^2)", core_.gravity_known ? vectorText(core_.gravity) : "not estimated yet");
   status.add("accelerometer bias (m/s^2)", vectorText(core_.accel_bias));
   status.add("accelerometer intervals gated", core_.accel_gated);
+  std::ostringstream tilt;
+  if (core_.tilt_deg) tilt << *core_.tilt_deg; else tilt << "not measured yet";
+  status.add("tilt against gravity (deg)", tilt.str());
+  status.add("scans held to gravity", core_.tilt_held);
 
   reported_fallbacks_ = fallbacks;
   reported_dropped_ = dropped;

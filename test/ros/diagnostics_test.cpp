@@ -165,16 +165,22 @@ TEST(RosDiagnostics, ImuAtItsRateIsOkAndSilenceSlownessAndFallbacksWarn) {
   EXPECT_EQ(valueOf(steady, "IMU samples taken"), "200");
   EXPECT_EQ(valueOf(steady, "gyro bias (deg/s)"), "1, 0, -0.5");
   EXPECT_EQ(valueOf(steady, "gravity in the odometry frame (m/s^2)"), "not estimated yet");
+  EXPECT_EQ(valueOf(steady, "tilt against gravity (deg)"), "not measured yet");
   core.gravity_known = true;
   core.gravity = {0.0, -0.5, -9.79};
   core.accel_bias = {0.05, 0.0, -0.02};
   core.accel_gated = 3;
+  core.tilt_deg = 0.25;
+  core.tilt_held = 4;
   statistics.update(core);
   const diagnostic_updater::DiagnosticStatusWrapper started = imuStatusAfter(statistics, 201, 0.005);
   EXPECT_EQ(valueOf(started, "gravity in the odometry frame (m/s^2)"), "0, -0.5, -9.79");
   EXPECT_EQ(valueOf(started, "accelerometer bias (m/s^2)"), "0.05, 0, -0.02");
   // The gate's intervals are counted, not warned of: the prior is the LiDAR's over them, as designed.
   EXPECT_EQ(valueOf(started, "accelerometer intervals gated"), "3");
+  // The hold's turns are counted, not warned of: a drift past imu.tilt_hold_deg, corrected.
+  EXPECT_EQ(valueOf(started, "tilt against gravity (deg)"), "0.25");
+  EXPECT_EQ(valueOf(started, "scans held to gravity"), "4");
   EXPECT_EQ(started.level, diagnostic_msgs::DiagnosticStatus::OK) << started.message;
   EXPECT_EQ(valueOf(steady, "scans on the LiDAR-only prior"), "0");
 

@@ -55,6 +55,10 @@ void printImuHealth(const Odometry& odometry) {
     std::printf(", %zu interval%s specific force gated (imu.accel_gate)", odometry.accelGatedCount(),
                 odometry.accelGatedCount() > 1 ? "s'" : "'s");
   }
+  const ImuStatus imu = odometry.imuStatus();
+  if (imu.tilt_held > 0) {
+    std::printf(", %zu scan%s turned back towards gravity (imu.tilt_hold_deg)", imu.tilt_held, imu.tilt_held > 1 ? "s" : "");
+  }
 }
 
 // The scans counted: processed, skipped (unreadable, or unusable to the odometry), degenerate, started in

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <deque>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "elo/config.hpp"
@@ -49,6 +50,11 @@ struct ImuStatus {
   // Intervals whose specific force the filter did not take, their translation missing the registered one
   // (imu.accel_gate): the scans after each on the LiDAR's translation until the velocity is registered again.
   size_t accel_gated = 0;
+  // Roll and pitch against gravity (TiltHold): how far the accelerometers' gravity over the last ten
+  // seconds is from the first ten seconds' (deg; nullopt before both), and the scans turned back towards
+  // it (imu.tilt_hold_deg).
+  std::optional<double> tilt_deg;
+  size_t tilt_held = 0;
 };
 
 // What the gyro says of one scan: the LiDAR's rotation since the scan before (between the two reference

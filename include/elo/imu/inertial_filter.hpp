@@ -54,6 +54,14 @@ class InertialFilter {
   // Everything is forgotten: the world frame changes.
   void reset();
 
+  // The world frame turned by `rotation` (a correction of the odometry's attitude, TiltHold): the
+  // velocity and gravity, which the filter holds in it, are turned alike.
+  void turnWorld(const Eigen::Matrix3d& rotation);
+
+  // The specific force integrated over `motion` (m/s), less the bias learnt, in the world frame: the
+  // change of the IMU's velocity less gravity's, `attitude` the LiDAR's rotation in the world at its start.
+  Eigen::Vector3d worldForce(const Preintegration& motion, const Eigen::Matrix3d& attitude) const;
+
   Eigen::Vector3d gravity() const { return state_.segment<3>(3); }
   Eigen::Vector3d velocity() const { return state_.head<3>(); }
   // The bias estimated online (m/s^2, the IMU's axes), on top of imu.accel_bias.

@@ -13,6 +13,7 @@
 #include "elo/pipeline/deskew.hpp"
 #include "elo/imu/imu_track.hpp"
 #include "elo/imu/inertial_filter.hpp"
+#include "elo/imu/tilt_hold.hpp"
 #include "elo/pipeline/motion_prior.hpp"
 #include "elo/pipeline/registration.hpp"
 #include "elo/sensor/sensor_height_check.hpp"
@@ -236,6 +237,10 @@ class Odometry {
   // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
   // reference frame in the world.
   void followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta);
+  // After an accepted registration: roll and pitch turned towards gravity past imu.tilt_hold_deg
+  // (TiltHold), the filter's world with them. `attitude_before`: the last accepted scan's reference frame
+  // in the world; `reference_time`: this scan's reference instant, s since the first scan.
+  void holdTilt(const Eigen::Matrix3d& attitude_before, double reference_time);
   // `velocity` (a sweep's twist per second) turning at the gyro's rate over the scan's sweep, when known.
   Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
@@ -300,6 +305,7 @@ class Odometry {
   ImuTrack imu_;
   GyroMotion gyro_;  // of the scan being processed
   InertialFilter inertial_;
+  TiltHold tilt_hold_;
   Preintegration inertial_interval_;  // of the scan being processed, since the last accepted one
   bool inertial_interval_known_ = false;
   // The LiDAR-only prior's translation for the scan being processed, when the motion model had one: the

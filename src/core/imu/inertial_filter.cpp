@@ -126,6 +126,18 @@ void InertialFilter::reset() {
   covariance_.setZero();
 }
 
+void InertialFilter::turnWorld(const Eigen::Matrix3d& rotation) {
+  Matrix9d turn = Matrix9d::Identity();
+  turn.block<3, 3>(0, 0) = rotation;
+  turn.block<3, 3>(3, 3) = rotation;
+  state_ = turn * state_;
+  covariance_ = turn * covariance_ * turn.transpose();
+}
+
+Eigen::Vector3d InertialFilter::worldForce(const Preintegration& motion, const Eigen::Matrix3d& attitude) const {
+  return attitude * (motion.velocity - motion.velocity_by_bias * state_.tail<3>());
+}
+
 Eigen::Vector3d InertialFilter::learntBias() const { return lidar_from_imu_.transpose() * state_.tail<3>(); }
 
 }  // namespace elo
