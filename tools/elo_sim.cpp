@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <fstream>
@@ -104,6 +105,9 @@ std::string usage() {
          "  --stamp-rounding S   record the stamps rounded to S seconds (times.txt, the scans, the bag), as\n"
          "                       KITTI-raw's are to 0.01; the ground truth stays at the true instants\n"
          "                       (default 0: exact)\n"
+         "  --truth-time-offset S\n"
+         "                       record the ground truth S seconds after each scan's stamp (poses.txt, the\n"
+         "                       bag's), as KITTI-raw's OXTS poses are off its scans' (default 0)\n"
          "  --threads N          worker threads (default 0: all cores)\n"
          "  --help               this text\n";
 }
@@ -131,7 +135,7 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
       "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
-      "--mirror", "--gait", "--stamp-rounding", "--imu", "--imu-rate"};
+      "--mirror", "--gait", "--stamp-rounding", "--truth-time-offset", "--imu", "--imu-rate"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -259,6 +263,10 @@ Options parseOptions(int argc, char** argv) {
   if (const auto rounding = take("--stamp-rounding")) {
     spec.stamp_rounding = elo::tools::parseNumber<double>("--stamp-rounding", *rounding);
     if (!(spec.stamp_rounding >= 0.0)) throw UsageError("--stamp-rounding must not be negative");
+  }
+  if (const auto offset = take("--truth-time-offset")) {
+    spec.truth_time_offset = elo::tools::parseNumber<double>("--truth-time-offset", *offset);
+    if (!std::isfinite(spec.truth_time_offset)) throw UsageError("--truth-time-offset must be a finite number");
   }
   if (const auto threads = take("--threads")) options.threads = static_cast<int>(parseInteger("--threads", *threads, 0));
   return options;

@@ -59,7 +59,7 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
   if (error) throw IoError("cannot create '" + scans.string() + "': " + error.message());
 
   const int frames = simulation.frameCount();
-  const Eigen::Isometry3d first_inverse = simulation.sensorPose(0).inverse();
+  const Eigen::Isometry3d first_inverse = simulation.recordedTruth(0).inverse();
   std::vector<Eigen::Isometry3d> poses(frames);
   std::vector<double> stamps(frames);
   size_t points = 0;
@@ -86,7 +86,7 @@ SequenceSummary writeSequence(const Simulation& simulation, const std::string& d
                                        }) &
           tbb::make_filter<Frame, void>(FilterMode::serial_in_order, [&](const Frame& frame) {
             poses[frame.index] = frame.index == 0 ? Eigen::Isometry3d::Identity()  // exactly, not up to rounding
-                                                  : first_inverse * simulation.sensorPose(frame.index);
+                                                  : first_inverse * simulation.recordedTruth(frame.index);
             stamps[frame.index] = simulation.recordedStamp(frame.index);
             points += frame.scan->cloud.size();
             if (sink) sink(*frame.scan, poses[frame.index]);

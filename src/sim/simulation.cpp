@@ -63,8 +63,12 @@ double Simulation::recordedStamp(int frame) const {
   return rounding > 0.0 ? std::round(stamp(frame) / rounding) * rounding : stamp(frame);
 }
 
-Eigen::Isometry3d Simulation::sensorPose(int frame) const {
-  const Eigen::Isometry3d pose = trajectory_->poseAt(stamp(frame));
+Eigen::Isometry3d Simulation::sensorPose(int frame) const { return poseAt(stamp(frame)); }
+
+Eigen::Isometry3d Simulation::recordedTruth(int frame) const { return poseAt(stamp(frame) + spec_.truth_time_offset); }
+
+Eigen::Isometry3d Simulation::poseAt(double time) const {
+  const Eigen::Isometry3d pose = trajectory_->poseAt(time);
   return spec_.mirrored ? mirrorOf(pose) : pose;
 }
 

@@ -1,6 +1,7 @@
 // Routes, the vehicle standing on the simulated ground, and drives through KITTI poses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -171,6 +172,39 @@ TEST(Gait, WalkAndTrotMoveTheSensorAsDescribed) {
   EXPECT_NEAR(robot.offsetAt(0.5 / robot.step_hz).translation().z(), 0.0, 1e-3) << "between footfalls";
   EXPECT_FALSE(gaitFromName("hop"));
   EXPECT_TRUE(gaitFromName("walk"));
+}
+
+// The recorded ground truth taken SimulationSpec::truth_time_offset after each stamp, as KITTI-raw's OXTS
+// poses are off its scans' (docs/real_drives.md): the sensor's pose at the shifted instant, the scans and
+// sensorPose() as they were; over a turn the truth's rotation between two scans is off the exact one's by
+// the turn over the offset at each end.
+TEST(Simulation, TheRecordedTruthIsTakenTheTruthTimeOffsetAfterEachStamp) {
+  SimulationSpec spec;
+  spec.trajectory = TrajectoryKind::curves;
+  spec.frames = 400;
+  SimulationSpec offset_spec = spec;
+  offset_spec.truth_time_offset = -0.012;
+  const Simulation exact(spec);
+  const Simulation offset(offset_spec);
+  double largest_rotation_error = 0.0;
+  double largest_bound = 0.0;
+  for (int frame = 0; frame < spec.frames; ++frame) {
+    ASSERT_TRUE(exact.recordedTruth(frame).isApprox(exact.sensorPose(frame), 0.0)) << frame;
+    ASSERT_TRUE(offset.sensorPose(frame).isApprox(exact.sensorPose(frame), 0.0)) << frame;
+    ASSERT_TRUE(offset.recordedTruth(frame).isApprox(offset.trajectory().poseAt(offset.stamp(frame) - 0.012), 0.0)) << frame;
+    if (frame == 0) continue;
+    const Eigen::Matrix3d truth_step = exact.sensorPose(frame - 1).linear().transpose() * exact.sensorPose(frame).linear();
+    const Eigen::Matrix3d recorded_step =
+        offset.recordedTruth(frame - 1).linear().transpose() * offset.recordedTruth(frame).linear();
+    largest_rotation_error = std::max(largest_rotation_error, Eigen::AngleAxisd(truth_step.transpose() * recorded_step).angle());
+    // The turn over the offset at either end of the step.
+    const auto turn_over_offset = [&](int at) {
+      return Eigen::AngleAxisd(offset.recordedTruth(at).linear().transpose() * exact.sensorPose(at).linear()).angle();
+    };
+    largest_bound = std::max(largest_bound, turn_over_offset(frame - 1) + turn_over_offset(frame));
+  }
+  EXPECT_GT(largest_rotation_error, 1e-5) << "the curves turn: the offset shows";
+  EXPECT_LE(largest_rotation_error, largest_bound + 1e-12);
 }
 
 TEST(SensorTrajectory, DrivenPosesAreFollowedInXY) {

@@ -36,6 +36,10 @@ struct SimulationSpec {
   // Seconds the scans' recorded stamps are rounded to (0: exact), as KITTI-raw's times.txt rounds them to
   // 10 ms: the scans are still taken a sweep apart, and the ground truth is at the true instants.
   double stamp_rounding = 0.0;
+  // Seconds by which the recorded ground truth is taken after each scan's stamp (0: at it), as KITTI-raw's
+  // OXTS poses are off the scans' stamps (about -12 ms on drive 0005, docs/real_drives.md): a turn of
+  // w rad/s then reads as w times this of rotation error at each end of a segment. Clamped to the drive.
+  double truth_time_offset = 0.0;
 };
 
 class Simulation {
@@ -52,6 +56,9 @@ class Simulation {
   // The stamp the frame's scan is recorded with: stamp(), rounded to SimulationSpec::stamp_rounding.
   double recordedStamp(int frame) const;
   Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the frame's reference instant
+  // The ground truth the frame is recorded with: the sensor's pose SimulationSpec::truth_time_offset after
+  // its reference instant, in the world frame.
+  Eigen::Isometry3d recordedTruth(int frame) const;
   SimulatedScan scan(int frame) const;
 
   const World& world() const { return *world_; }
@@ -59,6 +66,8 @@ class Simulation {
   const SensorTrajectory& trajectory() const { return *trajectory_; }
 
  private:
+  Eigen::Isometry3d poseAt(double time) const;  // mirrored with the drive
+
   SimulationSpec spec_;
   Lidar lidar_;
   std::unique_ptr<World> world_;
