@@ -203,6 +203,9 @@ TEST_F(ImuWalk, TheNodeletTracksTheSwungWalkAndTheNodeWithoutImuMessagesWarns) {
   EXPECT_GE(taken, needed) << describe(*walk_last);
   EXPECT_LE(taken, before_last_scan) << describe(*walk_last);
   EXPECT_NE(valueOf(*walk_last, "gyro bias (deg/s)"), "<missing>");
+  // The 4 s walk is shorter than the ten seconds the tilt against gravity is measured over.
+  EXPECT_EQ(valueOf(*walk_last, "tilt against gravity (deg)"), "not measured yet") << describe(*walk_last);
+  EXPECT_EQ(valueOf(*walk_last, "scans held to gravity"), "0");
 
   EXPECT_EQ(silent.messages().size(), clouds.size()) << "every scan gets a pose without the IMU";
   const std::string every_scan = std::to_string(clouds.size());
