@@ -360,12 +360,13 @@ TEST_F(ImuWalk, AStartMidSwingIsFoundAroundTheGyrosRotation) {
 }
 
 // Roll and pitch held to gravity (imu.tilt_hold_deg, TiltHold) on the walk taken on to 30 s, the
-// accelerometers read as the sensor gives them and then, from 12 s, with gravity turned by up to 3 deg about
-// the sensor's y axis over five seconds, as they would read it had the odometry's attitude tilted by as
-// much: held (the default band, 1 deg), the attitude is turned towards their gravity by what lies past the
-// band (1.25 deg), about a level axis, and the walk's heading and tracking stay as they were; the hold off,
-// the attitude is the LiDAR's and the tilt is only measured (2.0 deg). The walk as the sensor reads it measures under
-// 0.1 deg of tilt (the swings leave the bias out of the window's mean) and turns nothing.
+// accelerometers read as the sensor gives them and then, from 12 s, with gravity turned by up to 3 deg
+// about the sensor's y axis over five seconds, as they would read it had the odometry's attitude tilted
+// by as much: held (the default band, 1 deg), the attitude is turned towards their gravity by what lies
+// past the band (1.25 deg), about a level axis, and the walk's heading and tracking stay as they were;
+// the hold off, the attitude is the LiDAR's and the tilt is only measured (2.0 deg). The walk as the
+// sensor reads it measures under 0.1 deg of tilt (the swings leave the bias out of the window's mean) and
+// turns nothing.
 TEST(ImuTiltHold, TheAttitudeFollowsTheAccelerometersGravityPastTheBand) {
   const sim::SimulationSpec spec = test::walkSpec(kSweptVlp16, 300);
   const sim::Simulation simulation(spec);
