@@ -140,19 +140,20 @@ bool Odometry::preintegrateInterval(double previous_reference, double reference)
   return imu_.preintegrate(previous_reference, reference, inertial_interval_).empty();
 }
 
-void Odometry::followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta) {
+void Odometry::followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta,
+                              double reference_time) {
   if (!config_.imu.accelerometer) return;
+  std::optional<Eigen::Vector3d> force;
   if (gyro_.known && inertial_interval_known_) {
     if (!inertial_.update(inertial_interval_, attitude, reference_delta, lidar_prior_translation_)) ++accel_gated_;
+    force = inertial_.worldForce(inertial_interval_, attitude);
   } else {
     inertial_.forgetVelocity();
   }
+  holdTilt(force, reference_time);
 }
 
-void Odometry::holdTilt(const Eigen::Matrix3d& attitude_before, double reference_time) {
-  if (!config_.imu.accelerometer) return;
-  std::optional<Eigen::Vector3d> force;
-  if (gyro_.known && inertial_interval_known_) force = inertial_.worldForce(inertial_interval_, attitude_before);
+void Odometry::holdTilt(const std::optional<Eigen::Vector3d>& force, double reference_time) {
   const Eigen::Vector3d imu_position = modelPose() * Eigen::Map<const Eigen::Vector3d>(config_.imu.position.data());
   const Eigen::Matrix3d turn = tilt_hold_.follow(reference_time, imu_position, force);
   if (turn.isIdentity(0.0)) return;
@@ -433,9 +434,8 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
     } else {
       reference_delta = result.registration.model_from_scan;
       const Eigen::Matrix3d attitude_before = modelPose().linear();
-      if (config_.imu.enabled) followInertial(attitude_before, reference_delta);
       stamp_in_reference = acceptRegistration(reference_delta, dt, deskewed_under, times, result);
-      if (config_.imu.enabled) holdTilt(attitude_before, since_first + times.reference);
+      if (config_.imu.enabled) followInertial(attitude_before, reference_delta, since_first + times.reference);
       if (gyro_.known && result.registration.converged && !result.registration.degeneracy.any()) {
         imu_.learnBias(gyro_.rotation, reference_delta.linear(), dt);
       }

@@ -234,13 +234,14 @@ class Odometry {
     return inertial_.predictTranslation(inertial_interval_, modelPose().linear(), gyro_.rotation);
   }
   // The accepted registration `reference_delta` corrects the inertial filter, which moves on to this scan
-  // (its velocity forgotten when the IMU did not cover the interval). `attitude`: the last accepted scan's
-  // reference frame in the world.
-  void followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta);
-  // After an accepted registration: roll and pitch turned towards gravity past imu.tilt_hold_deg
-  // (TiltHold), the filter's world with them. `attitude_before`: the last accepted scan's reference frame
-  // in the world; `reference_time`: this scan's reference instant, s since the first scan.
-  void holdTilt(const Eigen::Matrix3d& attitude_before, double reference_time);
+  // (its velocity forgotten when the IMU did not cover the interval), and roll and pitch are held to
+  // gravity (holdTilt()). `attitude`: the last accepted scan's reference frame in the world;
+  // `reference_time`: this scan's reference instant, s since the first scan. After acceptRegistration().
+  void followInertial(const Eigen::Matrix3d& attitude, const Eigen::Isometry3d& reference_delta, double reference_time);
+  // Roll and pitch turned towards gravity past imu.tilt_hold_deg (TiltHold), the filter's world with them.
+  // `force`: the interval's specific force in the world (InertialFilter::worldForce()), when the IMU
+  // covered it.
+  void holdTilt(const std::optional<Eigen::Vector3d>& force, double reference_time);
   // `velocity` (a sweep's twist per second) turning at the gyro's rate over the scan's sweep, when known.
   Vector6d withGyroRate(Vector6d velocity) const;
   // One round: the scan deskewed again in place under `velocity`, its ground map rebuilt, timed in `result`.
