@@ -257,6 +257,12 @@ struct StartSearchConfig {
   // A candidate that ended elsewhere and scored within this of the winner makes the start ambiguous:
   // taken, counted and reported, as the scan does not tell the two motions apart.
   double margin = 0.02;
+  // A scan more than this many usual intervals after the scan before follows a gap: the motion prior does
+  // not hold across it, and its motion is searched on two lines, the velocity carried over the gap and
+  // over one usual interval (a clock that jumped). The usual interval is the sensor's period
+  // (1 / sensor.rotation_rate_hz), or the longer one the scans came at before (a throttled topic). Two
+  // missed scans (3 periods) are a gap; one (2 periods) is bridged by the prior.
+  double after_gap_periods = 2.5;
 };
 
 // An IMU beside the LiDAR (docs/imu.md): its gyro turns the motion prior and the deskew. Off by default,

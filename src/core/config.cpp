@@ -242,6 +242,8 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("start_search.yaw_step_deg", c.start_search.yaw_step_deg, "deg between the start search's yaws"),
       bindField("start_search.margin", c.start_search.margin,
                 "fit score within which a candidate that ended elsewhere makes a start ambiguous"),
+      bindField("start_search.after_gap_periods", c.start_search.after_gap_periods,
+                "usual scan intervals after which a scan follows a gap: its motion is searched"),
       bindField("imu.enabled", c.imu.enabled, "turn the motion prior and the deskew by the IMU's gyro (docs/imu.md)"),
       bindField("imu.position", c.imu.position, "m: the IMU's origin in the LiDAR frame, [x, y, z]"),
       bindField("imu.rotation_deg", c.imu.rotation_deg,
@@ -384,6 +386,7 @@ void validate(const Config& c) {
   require(start.max_yaw_rate_deg >= 0.0, "start_search.max_yaw_rate_deg", "must not be negative");
   require(start.yaw_step_deg > 0.0, "start_search.yaw_step_deg", "must be positive");
   require(start.margin >= 0.0, "start_search.margin", "must not be negative");
+  require(start.after_gap_periods > 1.0, "start_search.after_gap_periods", "must exceed one scan period");
   const ImuConfig& imu = c.imu;
   require(imu.position.size() == 3, "imu.position", "must list 3 numbers: x, y, z");
   require(imu.rotation_deg.size() == 3, "imu.rotation_deg", "must list 3 numbers: roll, pitch, yaw");

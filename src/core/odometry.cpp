@@ -1,7 +1,9 @@
 #include "elo/pipeline/odometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "core/elapsed_time.hpp"
 #include "elo/pipeline/deskew.hpp"
@@ -54,6 +56,34 @@ void Odometry::followTimeline(double stamp, FrameResult& result) {
   }
 }
 
+double Odometry::usualScanInterval() const {
+  return std::max(1.0 / config_.sensor.rotation_rate_hz, usual_scan_interval_);
+}
+
+void Odometry::followGap(double since_first, FrameResult& result) {
+  // From the scan before, refused or not: refusals in a row leave the registration's interval long, and
+  // are not a gap.
+  const double interval = since_first - previous_scan_since_first_;
+  previous_scan_since_first_ = since_first;
+  // Against the scans' own pace: a topic throttled to every third scan, or a run with --stride 3, has no
+  // gap at each scan. The first interval after a start sets it.
+  const bool gap = started_ && config_.start_search.enabled && usual_scan_interval_ > 0.0 &&
+                   interval > config_.start_search.after_gap_periods * usualScanInterval();
+  interval_before_gap_ = gap ? usualScanInterval() : 0.0;
+  usual_scan_interval_ = started_ ? interval : 0.0;
+  if (!gap) return;
+  // Scans were dropped, or the clock jumped forward: the sensor may have turned, stopped or moved a single
+  // scan period's worth, and a registration from the velocity carried over the gap converged metres off
+  // (a 0.3 s jump at 10 m/s: 3 m, accepted). The motion is searched instead, and is held against neither
+  // the velocity from before the gap nor the inliers: the model seen from 31 m on after a 3 s gap at
+  // 10 m/s gives a quarter of them, a collapse to the guard, which refused the scans after the gap until
+  // the model restarted.
+  motion_.reset();
+  guard_.reset();
+  result.gap = interval;
+  ++gaps_;
+}
+
 double Odometry::secondsSinceFirst(double stamp) const { return std::round((stamp - first_stamp_) * 1e9) / 1e9; }
 
 size_t Odometry::minOccupiedPixels() const {
@@ -97,7 +127,8 @@ Vector6d Odometry::registerAndDeskew(const Eigen::Isometry3d& guess, bool inform
                                      const Vector6d& deskewed, double farthest, FrameResult& result) {
   Vector6d deskewed_under = deskewed;
   const ScanRefresh deskew_again = [&](const Eigen::Isometry3d& estimate, bool converged) {
-    if (result.time_source == TimeSource::none) return false;
+    // Across a gap the registered motion tells no sweep velocity (see acceptRegistration()).
+    if (result.time_source == TimeSource::none || afterGap()) return false;
     // Against a model of the first scan as measured, the scan as measured registers best (the two are
     // bent alike): it is deskewed once, whatever deskew.rounds says, when the registration has converged,
     // only to replace that model.
@@ -233,12 +264,19 @@ Eigen::Isometry3d Odometry::acceptRegistration(const Eigen::Isometry3d& referenc
   // T^{t-1}_t between the stamps; exactly the reference delta when both references are the stamps.
   result.delta = stamp_in_reference_.inverse() * reference_delta * stamp_in_reference;
   pose_ = pose_ * result.delta;
-  motion_.record(reference_delta, dt);
   const Degeneracy& degeneracy = result.registration.degeneracy;
   if (degeneracy.any()) ++degenerate_;
-  motion_.holdVelocityAlong(degeneracy.priorShare());
-  held_velocity_ = motion_.latestVelocity();
   guard_.accept(result.registration, dt);
+  if (afterGap()) {
+    // The motion across a gap tells no velocity (over a clock that jumped, a fraction of the true one):
+    // the next scan is searched around the velocity from before the gap, and its registration gives the
+    // velocity anew.
+    guard_.forgetVelocity();
+  } else {
+    motion_.record(reference_delta, dt);
+    motion_.holdVelocityAlong(degeneracy.priorShare());
+    held_velocity_ = motion_.latestVelocity();
+  }
   if (refused_in_row_ > 0) {
     result.recovered = true;
     ++recoveries_;
@@ -328,11 +366,14 @@ bool Odometry::refuseRegistration(double dt, FrameResult& result) {
 }
 
 void Odometry::searchMotion(double dt, FrameResult& result) {
-  Eigen::Isometry3d centre = expSE3(held_velocity_ * dt);
+  std::vector<SearchLine> lines{{expSE3(held_velocity_ * dt), dt}};
+  if (afterGap()) lines.push_back({expSE3(held_velocity_ * interval_before_gap_), interval_before_gap_});
   // With the gyro's rotation over the interval every candidate takes it: a sensor turning fast at a start
   // (a handheld rig started mid-swing) is found by translations alone.
-  if (gyro_.known) centre.linear() = gyro_.rotation;
-  result.start_search = searchStartMotion(*backend_, dt, config_, centre,
+  if (gyro_.known) {
+    for (SearchLine& line : lines) line.centre.linear() = gyro_.rotation;
+  }
+  result.start_search = searchStartMotion(*backend_, lines, config_,
                                           gyro_.known ? StartRotation::from_gyro : StartRotation::search_yaw);
   ++start_searches_;
   if (result.start_search.ambiguous) ++ambiguous_starts_;
@@ -386,6 +427,7 @@ FrameResult Odometry::processScan(const PointCloud& cloud) {
   // references lie within their sweeps (0 but for `field` times).
   const double stamp_interval = since_first - last_since_first_ + (times.reference - last_reference_);
   const double dt = started_ ? motionInterval(stamp_interval, times.source, config_.sensor) : 0.0;
+  followGap(since_first, result);
 
   gyro_ = gyroMotion(cloud.stamp, times, result);
   auto stage_start = Clock::now();

@@ -36,14 +36,30 @@ std::vector<int> offsetsWithin(int n) {
   return offsets;
 }
 
-// Candidates along x every step within `reach` either way of `centre`, `centre` first.
-std::vector<Eigen::Isometry3d> motionsAlongX(const Eigen::Isometry3d& centre, double reach,
-                                             const StartSearchConfig& config) {
-  std::vector<Eigen::Isometry3d> motions;
-  for (int offset : offsetsWithin(stepsWithin(reach, config.step, kMaxStepsEachWay))) {
-    Eigen::Isometry3d motion = centre;
-    motion.translation().x() += offset * config.step;
-    motions.push_back(motion);
+// A candidate along x: its motion and the line it lies on.
+struct AlongX {
+  Eigen::Isometry3d motion;
+  int line;
+};
+
+// Candidates along x every step within motion.max_speed * interval either way of each line's centre, each
+// centre first; one within half a step of a candidate before it is left out (the lines after a gap
+// overlap when the vehicle was slow).
+std::vector<AlongX> motionsAlongX(const std::vector<SearchLine>& lines, const Config& config) {
+  const StartSearchConfig& search = config.start_search;
+  std::vector<AlongX> motions;
+  const auto tried = [&](const Eigen::Isometry3d& motion) {
+    return std::any_of(motions.begin(), motions.end(), [&](const AlongX& before) {
+      return (before.motion.translation() - motion.translation()).norm() < 0.5 * search.step;
+    });
+  };
+  for (size_t line = 0; line < lines.size(); ++line) {
+    const double reach = config.motion.max_speed * lines[line].interval;
+    for (int offset : offsetsWithin(stepsWithin(reach, search.step, kMaxStepsEachWay))) {
+      Eigen::Isometry3d motion = lines[line].centre;
+      motion.translation().x() += offset * search.step;
+      if (!tried(motion)) motions.push_back({motion, static_cast<int>(line)});
+    }
   }
   return motions;
 }
@@ -84,24 +100,25 @@ double fitScore(const NormalEquations& sums, const RegistrationConfig& config) {
   return term.JtJ.topLeftCorner<3, 3>().trace() / term.candidates;
 }
 
-StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
-                                    const Eigen::Isometry3d& centre, StartRotation rotation) {
+StartSearchResult searchStartMotion(Backend& backend, const std::vector<SearchLine>& lines, const Config& config,
+                                    StartRotation rotation) {
   const auto start = Clock::now();
   const StartSearchConfig& search = config.start_search;
-  const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * dt;
   // Along x first, then in yaw around where the best along x started: a turn within the search's yaw
   // reach hardly moves where the scan fits along x, so the two are searched one after the other rather
   // than on a grid of both, at a third of its cost. The gyro's rotation is good to a small fraction of a
   // yaw step (a bias of 0.5 deg/s turns 0.05 deg a scan), so centred on it the yaw candidates add nothing.
+  const std::vector<AlongX> along_x = motionsAlongX(lines, config);
   std::vector<Candidate> scored;
-  const std::vector<Eigen::Isometry3d> along_x = motionsAlongX(centre, config.motion.max_speed * dt, search);
-  for (const Eigen::Isometry3d& motion : along_x) {
-    scored.push_back(registerCandidate(backend, motion, config.registration));
+  for (const AlongX& candidate : along_x) {
+    scored.push_back(registerCandidate(backend, candidate.motion, config.registration));
   }
   const auto better = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
   if (rotation == StartRotation::search_yaw) {
     const size_t best_along_x = std::min_element(scored.begin(), scored.end(), better) - scored.begin();
-    for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x], yaw_reach, search)) {
+    const double interval = lines[along_x[best_along_x].line].interval;
+    const double yaw_reach = search.max_yaw_rate_deg * M_PI / 180.0 * interval;
+    for (const Eigen::Isometry3d& motion : yawsAround(along_x[best_along_x].motion, yaw_reach, search)) {
       scored.push_back(registerCandidate(backend, motion, config.registration));
     }
   }

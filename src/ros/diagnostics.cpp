@@ -114,6 +114,7 @@ void PipelineStatistics::scanProcessed(const elo::FrameResult& result, double la
   }
   if (!result.sensor_height_warning.empty()) last_sensor_height_warning_ = result.sensor_height_warning;
   if (result.start_search.searched) ++start_searches_;
+  if (result.gap > 0.0) ++gaps_;
   if (result.start_search.ambiguous) {
     ++ambiguous_starts_;
     ++window_.ambiguous_starts;
@@ -166,6 +167,7 @@ void PipelineStatistics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("scans degenerate", degenerate_scans_);
   status.add("start searches", start_searches_);
   status.add("ambiguous starts", ambiguous_starts_);
+  status.add("gaps searched", gaps_);
   for (const auto& [reason, count] : refusals_) status.add("registrations refused: " + reason, count);
   status.add("recoveries", recoveries_);
   status.add("model restarts after refusals", tracking_restarts_);

@@ -70,6 +70,7 @@ class PipelineStatistics {
   size_t failed_registrations_ = 0;
   size_t degenerate_scans_ = 0;
   size_t start_searches_ = 0;    // elo::FrameResult::start_search
+  size_t gaps_ = 0;              // elo::FrameResult::gap
   size_t ambiguous_starts_ = 0;  // ... whose winner did not stand out
   std::map<std::string, size_t> refusals_;  // refused registrations by reason
   size_t recoveries_ = 0;

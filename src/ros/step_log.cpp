@@ -16,7 +16,7 @@ void StepLog::log(const elo::DriveStep& step) {
     ROS_WARN_THROTTLE_NAMED(kWarningPeriod, name_, "per-point times: %s (deskew.time_source)", result.time_warning.c_str());
   }
   if (!result.sensor_warning.empty()) ROS_WARN_THROTTLE_NAMED(kWarningPeriod, name_, "%s", result.sensor_warning.c_str());
-  logStartSearch(result.start_search);
+  logStartSearch(result);
   logTrackingHealth(result);
   if (result.processed) return;
   statistics_.scanSkipped(result.skip_reason);
@@ -37,9 +37,17 @@ void StepLog::logRestart(const elo::DriveStep& step) {
   }
 }
 
-void StepLog::logStartSearch(const elo::StartSearchResult& search) {
+void StepLog::logStartSearch(const elo::FrameResult& result) {
+  const elo::StartSearchResult& search = result.start_search;
   if (!search.searched) return;
   const Eigen::Vector3d moved = search.motion.translation();
+  if (result.gap > 0.0) {
+    ROS_WARN_NAMED(name_,
+                   "%.2f s since the last scan (dropped scans or a clock jump): the motion prior does not hold; "
+                   "searched: %.2f m forward (%d candidates, %.0f ms)",
+                   result.gap, moved.x(), search.candidates, search.milliseconds);
+    return;
+  }
   if (search.ambiguous) {
     ROS_WARN_NAMED(name_,
                    "start in motion: ambiguous, another motion fits the first two scans about as well (score %.3f "

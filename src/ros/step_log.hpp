@@ -20,8 +20,9 @@ class StepLog {
  private:
   // Warns and counts when the odometry restarted at this scan.
   void logRestart(const elo::DriveStep& step);
-  // Says where the start search put a start in motion: a warning when the scans could not tell.
-  void logStartSearch(const elo::StartSearchResult& search);
+  // Says where the start search put a start in motion (a warning when the scans could not tell), and
+  // warns of a gap, whose motion was searched.
+  void logStartSearch(const elo::FrameResult& result);
   // Says when a registration was refused, the track recovered or the sensor height does not fit.
   void logTrackingHealth(const elo::FrameResult& result);
 

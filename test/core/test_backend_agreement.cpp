@@ -439,6 +439,27 @@ TEST(BackendAgreement, RefusalsAndRecoveriesAgree) {
   EXPECT_EQ(odometry.cuda.recoveryCount(), odometry.cpu.recoveryCount());
 }
 
+// A gap (docs/robustness.md#faulty-input): the scans' clock jumps 2 s forward while the car drives on;
+// both backends search the scan after it on the same two lines and track on alike.
+TEST(BackendAgreement, GapsAreSearchedAlike) {
+  ELO_REQUIRE_CUDA();
+  const Config config;
+  OdometryOnBothBackends odometry(RegistrationMode::frame_to_model);
+  for (int frame = 0; frame < 10; ++frame) {
+    const double stamp = 0.1 * frame + (frame >= 5 ? 2.0 : 0.0);
+    const PointCloud cloud = streetScan(config, pose(-20 + 0.8 * frame, 0, 0, 0, 0, 0), stamp, 0.02);
+    const FrameResult a = odometry.cpu.process(cloud);
+    const FrameResult b = odometry.cuda.process(cloud);
+    ASSERT_TRUE(a.processed && b.processed) << "frame " << frame;
+    EXPECT_EQ(a.gap, b.gap) << "frame " << frame;
+    EXPECT_EQ(a.start_search.candidates, b.start_search.candidates) << "frame " << frame;
+    expectAgreeingPoses(a.pose, b.pose, frame);
+  }
+  EXPECT_EQ(odometry.cpu.gapCount(), 1u);
+  EXPECT_EQ(odometry.cuda.gapCount(), odometry.cpu.gapCount());
+  EXPECT_EQ(odometry.cuda.refusalCounts(), odometry.cpu.refusalCounts());
+}
+
 // With an IMU (docs/imu.md) the gyro turns the guess and the deskew and the accelerometers carry the
 // guess's translation; the backends deskew and register under the same velocities and from the same
 // guesses, so they agree as without it. The samples are those of the drive's own motion: a circle at

@@ -99,14 +99,49 @@ TEST(FaultDrives, StartAtCruiseSpeedConverges) {
   EXPECT_LT(translationError(results.back().pose, UrbanDrive::instance().truth(kCruising + 5, kCruising)), 0.02);
 }
 
-// Three seconds without a scan (a driver restart, a network outage) at constant speed: the motion prior
-// scaled by the gap predicts the 31 m, and registration refines it.
-TEST(FaultDrives, ThreeSecondGapIsBridgedByTheMotionPrior) {
+// One scan dropped (0.2 s between two scans): within start_search.after_gap_periods, so the motion prior,
+// scaled by the interval, bridges it, and nothing is searched.
+TEST(FaultDrives, ADroppedScanIsBridgedByTheMotionPrior) {
+  UrbanDrive& urban = UrbanDrive::instance();
+  Odometry odometry{Config()};
+  const FrameResult before = drive(odometry, frameRange(0, kCruising + 10)).back();
+  const std::vector<FrameResult> after = drive(odometry, frameRange(kCruising + 11, kCruising + 20));
+  EXPECT_EQ(after.front().gap, 0.0);
+  EXPECT_FALSE(after.front().start_search.searched);
+  EXPECT_EQ(odometry.gapCount(), 0u);
+  EXPECT_LT(translationError(motion(before, after.front()), urban.truth(kCruising + 11, kCruising + 9)), 0.05)
+      << "the 2 m across the dropped scan";
+}
+
+// Every third scan (a throttled topic, elo_run --stride 3): the scans come at 0.3 s, 3 scan periods, which
+// becomes their usual interval after the first: no gap, nothing searched after the start, and the motion
+// prior carries them.
+TEST(FaultDrives, EveryThirdScanMakesNoGap) {
+  UrbanDrive& urban = UrbanDrive::instance();
+  Odometry odometry{Config()};
+  std::vector<int> frames;
+  for (int frame = kCruising; frame < kCruising + 60; frame += 3) frames.push_back(frame);
+  const std::vector<FrameResult> results = drive(odometry, frames);
+  EXPECT_EQ(odometry.gapCount(), 0u);
+  EXPECT_EQ(odometry.startSearchCount(), 1u) << "the start's only";
+  EXPECT_TRUE(odometry.refusalCounts().empty());
+  EXPECT_LT(translationError(motion(results.front(), results.back()), urban.truth(frames.back(), frames.front())), 0.05);
+}
+
+// Three seconds without a scan (a driver restart, a network outage) at constant speed: a gap, whose motion
+// is searched around the velocity carried over it (31 m) and around one scan period (1 m, a clock that
+// jumped; test_lost_track's ClockJump); the 31 m is found, and registration refines it. Nothing is refused:
+// the inliers against a model 31 m behind (a quarter of those before) are not a collapse after a gap.
+TEST(FaultDrives, ThreeSecondGapIsSearchedAcross) {
   UrbanDrive& urban = UrbanDrive::instance();
   Odometry odometry{Config()};
   const FrameResult before = drive(odometry, frameRange(0, kCruising + 10)).back();
   const std::vector<FrameResult> after = drive(odometry, frameRange(kCruising + 40, kCruising + 60));
   EXPECT_FALSE(after.front().gap_restart) << "3 s is within model.time_window";
+  EXPECT_NEAR(after.front().gap, 3.1, 1e-6);
+  EXPECT_TRUE(after.front().start_search.searched);
+  EXPECT_EQ(odometry.gapCount(), 1u);
+  for (const FrameResult& result : after) EXPECT_TRUE(result.refusal.empty()) << result.refusal;
   EXPECT_LT(translationError(motion(before, after.front()), urban.truth(kCruising + 40, kCruising + 9)), 0.05)
       << "the 31 m across the gap";
   EXPECT_LT(translationError(motion(after.front(), after.back()), urban.truth(kCruising + 59, kCruising + 40)), 0.05)

@@ -59,6 +59,18 @@ TEST(RosDiagnostics, StartSearchesAreCountedAndAnAmbiguousOneWarns) {
   EXPECT_EQ(valueOf(ambiguous, "ambiguous starts"), "1");
 }
 
+// A gap between scans, its motion searched, is counted; not a problem in itself (the node warns in its log).
+TEST(RosDiagnostics, GapsAreCounted) {
+  elo_ros::PipelineStatistics statistics;
+  elo::FrameResult across = processedScan(60.0);
+  across.gap = 2.1;
+  across.start_search.searched = true;
+  const diagnostic_updater::DiagnosticStatusWrapper status = statusAfterScan(statistics, across);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK) << status.message;
+  EXPECT_EQ(valueOf(status, "gaps searched"), "1");
+  EXPECT_EQ(valueOf(statusAfterScan(statistics, processedScan(60.0)), "gaps searched"), "1");
+}
+
 // A refused registration is lost: ERROR while it lasts, counted by reason; a recovery goes back to OK.
 TEST(RosDiagnostics, ARefusedRegistrationIsAnErrorUntilTheTrackRecovers) {
   elo_ros::PipelineStatistics statistics;

@@ -91,6 +91,18 @@ std::string scanPath(const fs::path& sequence, size_t index, const char* extensi
   return (sequence / "velodyne" / (name + std::string(extension))).string();
 }
 
+// The largest difference between two KITTI pose files' numbers; infinity when their lines differ in count.
+double largestDifference(const std::string& a, const std::string& b) {
+  const std::vector<Eigen::Isometry3d> first = elo::readKittiPoses(a);
+  const std::vector<Eigen::Isometry3d> second = elo::readKittiPoses(b);
+  if (first.size() != second.size()) return std::numeric_limits<double>::infinity();
+  double largest = 0.0;
+  for (size_t i = 0; i < first.size(); ++i) {
+    largest = std::max(largest, (first[i].matrix() - second[i].matrix()).cwiseAbs().maxCoeff());
+  }
+  return largest;
+}
+
 // Cuts a scan file short in the middle of a point, as an interrupted copy leaves it.
 void truncate(const std::string& path) { fs::resize_file(path, fs::file_size(path) / 2 + 3); }
 
@@ -158,6 +170,25 @@ TEST_F(EloRunCli, WarnsWhenFarPointsGetNoNormal) {
   const CommandResult papers = runEloRun("--frames 1");
   EXPECT_EQ(papers.exit_code, 0) << papers.output;
   EXPECT_FALSE(contains(papers.output, "get no normal")) << papers.output;
+}
+
+// The scans' clock jumps 2 s forward before scan 3 while the car drives on: elo_run says where, and that
+// the motion was searched across the gap, and the poses stay those of the intact drive.
+TEST_F(EloRunCli, AClockJumpIsToldAndSearchedAcross) {
+  const fs::path times = sequence_ / "times.txt";
+  const std::vector<std::string> stamps = lines(times.string());
+  ASSERT_EQ(stamps.size(), kScans);
+  {
+    std::ofstream rewritten(times);
+    for (size_t i = 0; i < kScans; ++i) rewritten << std::stod(stamps[i]) + (i >= 3 ? 2.0 : 0.0) << "\n";
+  }
+  const CommandResult result = runEloRun();
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(contains(result.output, "scan 3: 2.10 s after the last scan (dropped scans or a clock jump)")) << result.output;
+  EXPECT_TRUE(contains(result.output, "1 gap between scans (the motion searched across)")) << result.output;
+  const std::vector<std::string> written = lines(poses());
+  ASSERT_EQ(written.size(), kScans);
+  EXPECT_LT(largestDifference(poses(), drive_->file("intact.txt")), 0.01);
 }
 
 TEST_F(EloRunCli, TruncatedLastScanIsSkippedAndRepeatsTheLastPose) {
@@ -498,21 +529,6 @@ TEST_F(EloRunCli, ImuTxtBesideTheScansTurnsEveryScan) {
   EXPECT_TRUE(contains(without_file.output, "imu.txt")) << without_file.output;
 }
 
-namespace {
-
-// The largest difference between two KITTI pose files' numbers; infinity when their lines differ in count.
-double largestDifference(const std::string& a, const std::string& b) {
-  const std::vector<Eigen::Isometry3d> first = elo::readKittiPoses(a);
-  const std::vector<Eigen::Isometry3d> second = elo::readKittiPoses(b);
-  if (first.size() != second.size()) return std::numeric_limits<double>::infinity();
-  double largest = 0.0;
-  for (size_t i = 0; i < first.size(); ++i) {
-    largest = std::max(largest, (first[i].matrix() - second[i].matrix()).cwiseAbs().maxCoeff());
-  }
-  return largest;
-}
-
-}  // namespace
 
 // elo_sim --imu --bag writes the IMU twice: imu.txt beside the scans, sensor_msgs/Imu on the bag's /imu
 // (stamped as its clouds, a second later). elo_run takes the bag's only Imu topic and gives the poses of

@@ -84,6 +84,10 @@ void printCounts(const DriveSession& session, size_t scans) {
       std::printf(" (%zu ambiguous: another motion fit about as well)", odometry.ambiguousStartCount());
     }
   }
+  if (odometry.gapCount() > 0) {
+    std::printf(", %zu gap%s between scans (the motion searched across)", odometry.gapCount(),
+                odometry.gapCount() > 1 ? "s" : "");
+  }
   printTrackingHealth(odometry);
   printImuHealth(odometry);
   if (odometry.sensorMisfitCount() > 0) {

@@ -119,6 +119,10 @@ void ScanLoop::tellOdometry(size_t scan, const FrameResult& result) {
                  result.tracking_restart ? "; model restarted from this scan" : "");
   }
   if (result.recovered) std::fprintf(stderr, "\nscan %zu: tracking recovered\n", scan);
+  if (result.gap > 0.0) {
+    std::fprintf(stderr, "\nscan %zu: %.2f s after the last scan (dropped scans or a clock jump): motion searched, %.2f m\n",
+                 scan, result.gap, result.delta.translation().norm());
+  }
   if (!result.imu_fallback.empty()) std::fprintf(stderr, "\nscan %zu: LiDAR-only prior: %s\n", scan, result.imu_fallback.c_str());
   if (!result.processed) std::fprintf(stderr, "\nscan %zu skipped: %s\n", scan, result.skip_reason.c_str());
   if (result.reset) std::fprintf(stderr, "\nscan %zu: time went backwards, odometry restarted\n", scan);

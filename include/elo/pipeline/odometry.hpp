@@ -39,6 +39,10 @@ struct FrameResult {
   // The gap since the previous scan exceeded model.time_window: the model and the motion prior restarted
   // at the last pose, which this scan keeps (the motion during the gap is unknown).
   bool gap_restart = false;
+  // The interval (s) since the scan before, when it exceeded start_search.after_gap_periods times the
+  // usual one (a shorter gap than time_window: dropped scans, or a clock that jumped forward); 0 otherwise.
+  // The motion prior did not hold across it: the motion was searched (start_search) and gave no velocity.
+  double gap = 0.0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // sensor in the odometry frame
   Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();  // T^{t-1}_t
   RegistrationResult registration;  // of the last round
@@ -128,6 +132,8 @@ class Odometry {
   size_t sensorMisfitCount() const { return sensor_misfits_; }
   // Start searches run (FrameResult::start_search), and those whose winner did not stand out.
   size_t startSearchCount() const { return start_searches_; }
+  // Scans after a gap shorter than model.time_window, their motion searched (FrameResult::gap).
+  size_t gapCount() const { return gaps_; }
   size_t ambiguousStartCount() const { return ambiguous_starts_; }
   // Tracking health: refused registrations by reason, recoveries after them, model restarts after
   // motion.restart_after refusals in a row, and whether the latest registration was refused (lost).
@@ -191,14 +197,22 @@ class Odometry {
   // scan ends deskewed under.
   Vector6d searchAfterRefusal(double dt, const Vector6d& projected_under, const Vector6d& deskewed_under,
                               double farthest, FrameResult& result);
+  // Whether the scan `since_first` seconds after the first follows a gap (FrameResult::gap): then neither
+  // the motion prior nor the tracking guard's last velocity holds for it.
+  void followGap(double since_first, FrameResult& result);
+  // The interval the scans come at: the sensor's period, or the longer one between the scan before and
+  // the one before it (a throttled topic).
+  double usualScanInterval() const;
+  bool afterGap() const { return interval_before_gap_ > 0.0; }
   // The registration's initial guess: the motion prior's prediction, or where the start search puts the
   // scan when no motion is known yet (recorded in `result`).
   Eigen::Isometry3d initialGuess(double dt, FrameResult& result);
   // The start search (start_search.hpp) for a scan whose motion is unknown: around the motion accepted
   // last carried over `dt` when a refusal made the motion unknown (its reach along x spans a vehicle that
-  // stopped as well as one that drove on); around the identity at a start, when none was accepted. With
-  // the gyro's rotation over the interval, every candidate takes it and only translations are searched.
-  // Recorded in `result.start_search` and counted.
+  // stopped as well as one that drove on); around the identity at a start, when none was accepted; after a
+  // gap, around that motion and the one of the usual scan interval too (a clock that jumped). With the gyro's
+  // rotation over the interval, every candidate takes it and only translations are searched. Recorded in
+  // `result.start_search` and counted.
   void searchMotion(double dt, FrameResult& result);
   // The velocity a scan is deskewed under before it is registered: the last registered (the motion
   // prior's), or after a refusal the one accepted last; zero at a start and without a motion prior.
@@ -287,6 +301,8 @@ class Odometry {
   double first_stamp_ = 0.0;
   double last_stamp_ = 0.0;
   double last_since_first_ = 0.0;  // secondsSinceFirst(last_stamp_)
+  double previous_scan_since_first_ = 0.0;  // of the scan before, registered or refused
+  double usual_scan_interval_ = 0.0;        // between the scan before and the one before it; 0 at a start
   size_t processed_ = 0;
   size_t degenerate_ = 0;
   std::map<std::string, size_t> skipped_;
@@ -294,6 +310,7 @@ class Odometry {
   size_t sensor_misfits_ = 0;
   size_t start_searches_ = 0;
   size_t ambiguous_starts_ = 0;
+  size_t gaps_ = 0;
   TrackingGuard guard_;
   SensorHeightCheck height_check_;
   // The velocity of the last accepted registration (twist per second), which carries refused scans; kept
@@ -305,6 +322,8 @@ class Odometry {
   size_t tracking_restarts_ = 0;
   ImuTrack imu_;
   GyroMotion gyro_;  // of the scan being processed
+  // The usual scan interval before the gap the scan being processed follows (FrameResult::gap); 0: none.
+  double interval_before_gap_ = 0.0;
   InertialFilter inertial_;
   TiltHold tilt_hold_;
   Preintegration inertial_interval_;  // of the scan being processed, since the last accepted one

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "elo/pipeline/backend.hpp"
 #include "elo/config.hpp"
@@ -49,17 +50,24 @@ struct StartSearchResult {
 // count, under the 1 m correspondence gate, barely tells 0.5 m from the truth.
 double fitScore(const NormalEquations& sums, const RegistrationConfig& config);
 
-// Searches the motion of the backend's projected scan against its model, `dt` seconds after the model's
-// scan: candidates every start_search.step metres along x within motion.max_speed * dt either way,
-// then (but with the gyro's rotation) at every yaw step within start_search.max_yaw_rate_deg * dt around
-// the best of those, each registered from a loose kernel for a few Gauss-Newton steps and scored by
-// fitScore() under the final kernel.
-// `centre`: the motion the candidates lie around; the identity at a start, the motion last accepted
-// carried over `dt` when the scan's registration from the prior was refused. `rotation` from_gyro: the
-// centre's rotation is the gyro's, and the search tries translations along x only (a handheld sensor
-// swung at 190 deg/s turns 19 deg a scan, far beyond the yaw candidates' reach).
-StartSearchResult searchStartMotion(Backend& backend, double dt, const Config& config,
-                                    const Eigen::Isometry3d& centre = Eigen::Isometry3d::Identity(),
+// A line of candidates along x: around `centre`, the motion a scan `interval` seconds after the model's
+// is expected near, within motion.max_speed * `interval` either way.
+struct SearchLine {
+  Eigen::Isometry3d centre = Eigen::Isometry3d::Identity();
+  double interval = 0.0;
+};
+
+// Searches the motion of the backend's projected scan against its model: candidates every
+// start_search.step metres along x on each line (a candidate within half a step of one tried before is
+// not tried again), then (but with the gyro's rotation) at every yaw step within
+// start_search.max_yaw_rate_deg times the best candidate's line interval around it, each registered from
+// a loose kernel for a few Gauss-Newton steps and scored by fitScore() under the final kernel.
+// The lines: around the identity at a start, when no motion was accepted; around the motion accepted
+// last carried over the interval when the scan's registration from the prior was refused; after a gap,
+// that line and the one of a single scan period (the stamps jumped, the sensor did not).
+// `rotation` from_gyro: the centres' rotation is the gyro's, and the search tries translations along x
+// only (a handheld sensor swung at 190 deg/s turns 19 deg a scan, far beyond the yaw candidates' reach).
+StartSearchResult searchStartMotion(Backend& backend, const std::vector<SearchLine>& lines, const Config& config,
                                     StartRotation rotation = StartRotation::search_yaw);
 
 }  // namespace elo

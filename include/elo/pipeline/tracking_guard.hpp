@@ -35,7 +35,10 @@ class TrackingGuard {
   // Records an accepted registration over `dt`: its velocity and inliers, which the next ones are held
   // against.
   void accept(const RegistrationResult& registration, double dt);
-  // Forgets them: the model restarted, and what a new model gives is not held against the old one's.
+  // Forgets the velocity accepted last: the next registration (after a gap) is not held against it.
+  void forgetVelocity() { previous_velocity_.reset(); }
+  // Forgets them: the model restarted, or the scan follows a gap (Odometry::followGap()), and what it
+  // gives is not held against what came before.
   void reset() {
     recent_inliers_.clear();
     previous_velocity_.reset();
