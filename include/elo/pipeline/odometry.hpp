@@ -198,7 +198,7 @@ class Odometry {
   Vector6d searchAfterRefusal(double dt, const Vector6d& projected_under, const Vector6d& deskewed_under,
                               double farthest, FrameResult& result);
   // Whether the scan `since_first` seconds after the first follows a gap (FrameResult::gap): then neither
-  // the motion prior nor the tracking guard's last velocity holds for it.
+  // the motion prior nor what the tracking guard holds registrations against (velocity, inliers) holds.
   void followGap(double since_first, FrameResult& result);
   // The interval the scans come at: the sensor's period, or the longer one between the scan before and
   // the one before it (a throttled topic).

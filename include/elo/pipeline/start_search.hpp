@@ -64,7 +64,7 @@ struct SearchLine {
 // a loose kernel for a few Gauss-Newton steps and scored by fitScore() under the final kernel.
 // The lines: around the identity at a start, when no motion was accepted; around the motion accepted
 // last carried over the interval when the scan's registration from the prior was refused; after a gap,
-// that line and the one of a single scan period (the stamps jumped, the sensor did not).
+// that line and the one of the usual scan interval (the stamps jumped, the sensor did not).
 // `rotation` from_gyro: the centres' rotation is the gyro's, and the search tries translations along x
 // only (a handheld sensor swung at 190 deg/s turns 19 deg a scan, far beyond the yaw candidates' reach).
 StartSearchResult searchStartMotion(Backend& backend, const std::vector<SearchLine>& lines, const Config& config,
