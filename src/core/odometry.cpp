@@ -67,9 +67,10 @@ void Odometry::followGap(double since_first, FrameResult& result) {
   previous_scan_since_first_ = since_first;
   // Against the scans' own pace: a topic throttled to every third scan, or a run with --stride 3, has no
   // gap at each scan. The first interval after a start sets it.
+  const double usual = usualScanInterval();
   const bool gap = started_ && config_.start_search.enabled && usual_scan_interval_ > 0.0 &&
-                   interval > config_.start_search.after_gap_periods * usualScanInterval();
-  interval_before_gap_ = gap ? usualScanInterval() : 0.0;
+                   interval > config_.start_search.after_gap_periods * usual;
+  interval_before_gap_ = gap ? usual : 0.0;
   usual_scan_interval_ = started_ ? interval : 0.0;
   if (!gap) return;
   // Scans were dropped, or the clock jumped forward: the sensor may have turned, stopped or moved a single
