@@ -130,6 +130,8 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("ground.max_slope_deg", g.max_slope_deg, "delta_theta: slope limit between column neighbours, deg (Eq. 13)"),
       bindField("ground.rise_tolerance", g.rise_tolerance,
                 "rise allowed between column neighbours on top of delta_theta's, m (range noise)"),
+      bindField("ground.min_range", g.min_range,
+                "ground points nearer the sensor stay out of the ground map (ground term and model), m; 0: none"),
       bindChoice("normals.method", n.method,
                  {{NormalMethod::range_adaptive, "range_adaptive"},
                   {NormalMethod::eigen, "eigen"},
@@ -327,6 +329,7 @@ void validate(const Config& c) {
   require(g.band_below > 0.0, "ground.band_below", "must be positive");
   require(g.max_slope_deg > 0.0 && g.max_slope_deg < 90.0, "ground.max_slope_deg", "must lie in (0, 90)");
   require(g.rise_tolerance >= 0.0, "ground.rise_tolerance", "must not be negative");
+  require(g.min_range >= 0.0, "ground.min_range", "must not be negative");
 
   const NormalConfig& n = c.normals;
   require(n.search_size > 0.0, "normals.search_size", "must be positive");

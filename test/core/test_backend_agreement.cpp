@@ -192,7 +192,9 @@ TEST(BackendAgreement, GroundLabelsAreIdentical) {
   ELO_REQUIRE_CUDA();
   Config all_points;
   all_points.registration.terms = CostTerms::spherical_all;
-  for (const Config& config : {Config(), all_points}) {
+  Config near_road_out;
+  near_road_out.ground.min_range = 8.0;
+  for (const Config& config : {Config(), all_points, near_road_out}) {
     Backends backends(config);
     const PointCloud cloud = streetScan(config, Eigen::Isometry3d::Identity(), 0.0, 0.02);
     for (Backend* backend : {backends.cpu.get(), backends.cuda.get()}) {
@@ -240,11 +242,15 @@ TEST(BackendAgreement, WindowsTooLargeForATileStopTheCudaBackendNamingTheParamet
 
 TEST(BackendAgreement, ScanGroundMapsAreIdenticalInTheSameOrder) {
   ELO_REQUIRE_CUDA();
-  const Config config;
-  Backends backends(config);
-  backends.prepare(streetScan(config, pose(-3, 0.5, 0, 0, 0, 10), 0.0, 0.02), 0.0f);
-  EXPECT_GT(backends.cpu->scanGround().size(), 10000u);
-  expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
+  for (const double min_range : {0.0, 8.0}) {
+    SCOPED_TRACE("ground.min_range " + std::to_string(min_range));
+    Config config;
+    config.ground.min_range = min_range;
+    Backends backends(config);
+    backends.prepare(streetScan(config, pose(-3, 0.5, 0, 0, 0, 10), 0.0, 0.02), 0.0f);
+    EXPECT_GT(backends.cpu->scanGround().size(), 10000u);
+    expectSameGroundMap(backends.cpu->scanGround(), backends.cuda->scanGround());
+  }
 }
 
 // `cloud` projected by both backends deskewed under `prior` (each point turned by `gyro` when it is

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "analytic_scene.hpp"
+#include "core/common/ground.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/pixel_lanes.hpp"
 #include "core/cpu/stages.hpp"
@@ -272,6 +273,50 @@ TEST(GroundSegmentation, SeparatesTheRoadFromWallsCarsAndPoles) {
   // Only the last ring before an object can fail the slope test towards it.
   EXPECT_GT(static_cast<double>(ground_labelled_ground) / ground_points, 0.97);
   EXPECT_EQ(object_labelled_ground, 0u);
+}
+
+// ground.min_range: nearer than it, every point in the ground band is ground, whatever its slope (the
+// road, and the foot of the cars and walls there), and the scan's ground map holds none of them; beyond
+// it, the labels and the map are those of the whole scan.
+TEST(GroundSegmentation, MinRangeKeepsTheNearBandOutOfBothTermsAndChangesNothingBeyond) {
+  constexpr float kMinRange = 8.0f;
+  Config gated_config;
+  gated_config.ground.min_range = kMinRange;
+  Projected whole = projectStreet(Config());
+  Projected gated = projectStreet(gated_config);
+  for (Projected* run : {&whole, &gated}) {
+    run->backend->segmentGround();
+    run->backend->buildGroundMap();
+  }
+  const ScanImage& whole_scan = whole.backend->scan();
+  const ScanImage& gated_scan = gated.backend->scan();
+  const GroundBand band = GroundBand::fromConfig(gated_config.ground);
+  size_t near_road = 0;
+  size_t near_objects_taken_out = 0;
+  for (size_t pixel = 0; pixel < gated_scan.image.pixelCount(); ++pixel) {
+    if (!gated_scan.image.occupied(pixel)) continue;
+    const Vec3f& vertex = gated_scan.image.vertex[pixel];
+    if (vertex.norm() >= kMinRange) {
+      ASSERT_EQ(gated_scan.label[pixel], whole_scan.label[pixel]) << "pixel " << pixel << " beyond the gate";
+      continue;
+    }
+    if (vertex.z() <= band.lowest || vertex.z() >= band.highest) continue;
+    EXPECT_EQ(gated_scan.label[pixel], PixelLabel::ground) << "pixel " << pixel << " in the band, " << vertex.norm() << " m";
+    const bool on_road = gated.truth.surface[gated_scan.point_index[pixel]] == Surface::ground;
+    near_road += on_road;
+    near_objects_taken_out += !on_road && whole_scan.label[pixel] == PixelLabel::nonground;
+  }
+  EXPECT_GT(near_road, 1000u);
+  EXPECT_GT(near_objects_taken_out, 10u);
+
+  const BevImage& whole_map = whole.backend->scanGround();
+  const BevImage& gated_map = gated.backend->scanGround();
+  size_t whole_beyond = 0;
+  for (const Vec3f& point : whole_map.vertex) whole_beyond += point.norm() >= kMinRange;
+  for (const Vec3f& point : gated_map.vertex) ASSERT_GE(point.norm(), kMinRange);
+  EXPECT_GT(whole_map.size(), whole_beyond + 1000);
+  // A cell on the gate's circle may have kept a point just inside it, and now keeps one just outside.
+  EXPECT_NEAR(static_cast<double>(gated_map.size()), static_cast<double>(whole_beyond), 0.01 * whole_beyond);
 }
 
 // Normals compared with the true plane, on pixels at least 0.5 m from any edge of their face (closer,

@@ -23,14 +23,20 @@ struct GroundBand {
   float highest;         // -h_g + delta_h1
   float max_tangent;     // tan(delta_theta)
   float rise_tolerance;  // rise allowed on top of delta_theta's, m
+  float min_range;       // ground.min_range, m
 
   static GroundBand fromConfig(const GroundConfig& config) {
     const float road = static_cast<float>(-config.sensor_height);
     return {road - static_cast<float>(config.band_below), road + static_cast<float>(config.band_above),
             static_cast<float>(std::tan(config.max_slope_deg * M_PI / 180.0)),
-            static_cast<float>(config.rise_tolerance)};
+            static_cast<float>(config.rise_tolerance), static_cast<float>(config.min_range)};
   }
 };
+
+// Whether `point` lies nearer the sensor than `range`.
+ELO_HOST_DEVICE inline bool withinRange(const Float3& point, float range) {
+  return point.x * point.x + point.y * point.y + point.z * point.z < range * range;
+}
 
 ELO_HOST_DEVICE inline bool gentleSlope(const Float3& a, const Float3& b, const GroundBand& band) {
   const float rise = std::fabs(a.z - b.z);
@@ -40,9 +46,14 @@ ELO_HOST_DEVICE inline bool gentleSlope(const Float3& a, const Float3& b, const 
 }
 
 // Whether `point` is ground, given the occupied pixels above and below it in its column (null: none).
+// Nearer than ground.min_range, a point in the band is ground whatever its slope, so that it enters
+// neither term: not the ground map (joinsGroundMap()), and not the non-ground image as a road point that
+// failed the slope test.
 ELO_HOST_DEVICE inline bool isGround(const Float3& point, const Float3* above, const Float3* below,
                                      const GroundBand& band) {
-  if (!(point.z > band.lowest && point.z < band.highest) || (above == nullptr && below == nullptr)) return false;
+  if (!(point.z > band.lowest && point.z < band.highest)) return false;
+  if (withinRange(point, band.min_range)) return true;
+  if (above == nullptr && below == nullptr) return false;
   if (above != nullptr && !gentleSlope(point, *above, band)) return false;
   return below == nullptr || gentleSlope(point, *below, band);
 }
@@ -51,6 +62,11 @@ ELO_HOST_DEVICE inline bool isGround(const Float3& point, const Float3* above, c
 ELO_HOST_DEVICE inline PixelLabel groundLabel(const Float3& point, const Float3* above, const Float3* below,
                                               const GroundBand& band) {
   return isGround(point, above, below, band) ? PixelLabel::ground : PixelLabel::nonground;
+}
+
+// Whether a ground pixel at `vertex` joins the scan's ground map, so the ground term and the ground model.
+ELO_HOST_DEVICE inline bool joinsGroundMap(PixelLabel label, const Float3& vertex, const GroundBand& band) {
+  return label == PixelLabel::ground && !withinRange(vertex, band.min_range);
 }
 
 // Labels every occupied pixel of column `col` ground or non-ground.

@@ -5,15 +5,18 @@
 
 #include "core/common/association.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/common/ground.hpp"
 #include "core/cpu/image_views.hpp"
 #include "core/cpu/parallel.hpp"
 #include "core/cpu/stages.hpp"
 
 namespace elo::cpu {
 
-std::vector<int32_t> groundPixels(const ScanImage& scan) {
+std::vector<int32_t> groundPixels(const ScanImage& scan, const GroundBand& band) {
   std::vector<int32_t> pixels;
-  parallelSelect(scan.label.size(), [&](size_t pixel) { return scan.label[pixel] == PixelLabel::ground; }, pixels);
+  parallelSelect(
+      scan.label.size(),
+      [&](size_t pixel) { return joinsGroundMap(scan.label[pixel], toFloat3(scan.image.vertex[pixel]), band); }, pixels);
   return pixels;
 }
 

@@ -71,7 +71,7 @@ void CpuBackend::segmentGround() {
     } else {
       cpu::segmentGround(config_.ground, scan_);
     }
-    ground_pixels_ = groundPixels(scan_);
+    ground_pixels_ = groundPixels(scan_, GroundBand::fromConfig(config_.ground));
   });
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/common/deskew.hpp"
 #include "core/common/eigen_interop.hpp"
+#include "core/common/ground.hpp"
 #include "core/common/map_render.hpp"
 #include "core/common/model_update.hpp"
 #include "core/common/normals.hpp"
@@ -106,8 +107,8 @@ struct GroundMapScratch {
   std::vector<int32_t> first_offers;    // per slot: the first offer to its cell
 };
 
-// bev_map.cpp: the pixels labelled ground, in increasing order.
-std::vector<int32_t> groundPixels(const ScanImage& scan);
+// bev_map.cpp: the ground pixels that join the scan's ground map (joinsGroundMap()), in increasing order.
+std::vector<int32_t> groundPixels(const ScanImage& scan, const GroundBand& band);
 // The BEV map of the ground pixels `ground_pixels` (groundPixels()): per cell, the first pixel on the
 // closest surface (fillGroundMap below).
 void buildGroundMap(const ScanImage& scan, const std::vector<int32_t>& ground_pixels, const BevProjection& projection,

@@ -2,6 +2,7 @@
 // compaction of bev_compaction.cuh, which keeps in each cell the oldest point on the surface closest to
 // the sensor, the points in the order the CPU backend inserts them.
 #include "core/common/association.hpp"
+#include "core/common/ground.hpp"
 #include "core/common/model_update.hpp"
 #include "core/cuda/bev_compaction.cuh"
 #include "core/cuda/kernels.hpp"
@@ -11,9 +12,10 @@ namespace elo::cuda {
 
 namespace {
 
-// The points of the scan's ground map come from the ground pixels of the scan image.
+// The points of the scan's ground map come from the ground pixels of the scan image that join it.
 struct PixelSources {
   DeviceScan scan;
+  GroundBand band;
 
   __device__ PixelSources counted() const { return *this; }
   __device__ int count() const { return scan.pixels(); }
@@ -23,7 +25,10 @@ struct PixelSources {
   __device__ int offer(int source, const BevProjection& projection, float& range) const {
     int row = 0;
     int col = 0;
-    if (scan.labels[source] != PixelLabel::ground || !projection.cellOf(scan.vertices[source], row, col)) return -1;
+    if (!joinsGroundMap(scan.labels[source], scan.vertices[source], band) ||
+        !projection.cellOf(scan.vertices[source], row, col)) {
+      return -1;
+    }
     range = norm(scan.vertices[source]);
     return row * projection.cols + col;
   }
@@ -89,9 +94,10 @@ __global__ void copyPoints(DeviceBev from, DeviceBev to) {
 
 size_t compactionTiles(size_t sources) { return (sources + kThreads - 1) / kThreads; }
 
-void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
-                    const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream) {
-  cell_compaction::compact(PixelSources{scan}, blocksFor(scan.pixels()), projection, same_surface_distance, compaction,
+void buildGroundMap(const DeviceScan& scan, const GroundBand& band, const BevProjection& projection,
+                    float same_surface_distance, const DeviceBev& ground, const CellCompaction& compaction,
+                    cudaStream_t stream) {
+  cell_compaction::compact(PixelSources{scan, band}, blocksFor(scan.pixels()), projection, same_surface_distance, compaction,
                            ground, stream);
 }
 

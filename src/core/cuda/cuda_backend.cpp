@@ -378,8 +378,8 @@ void CudaBackend::estimateNormals() {
 }
 
 void CudaBackend::buildGroundMap() {
-  cuda::buildGroundMap(deviceScan(), bev_, static_cast<float>(config_.model.same_surface_distance), scanGroundMap(),
-                       compaction(), stream_.get());
+  cuda::buildGroundMap(deviceScan(), ground_band_, bev_, static_cast<float>(config_.model.same_surface_distance),
+                       scanGroundMap(), compaction(), stream_.get());
   scan_ground_view_current_ = false;
 }
 

@@ -83,9 +83,11 @@ void estimateNormals(const DeviceScan& scan, const NormalParams& params, const F
                      cudaStream_t stream);
 
 // bev_map.cu: BEV maps (Sec. III-C.2, III-D). Each cell keeps the oldest point on its closest surface
-// (model_update.hpp), the points in the order the CPU backend inserts them (see bev_map.cu).
-void buildGroundMap(const DeviceScan& scan, const BevProjection& projection, float same_surface_distance,
-                    const DeviceBev& ground, const CellCompaction& compaction, cudaStream_t stream);
+// (model_update.hpp), the points in the order the CPU backend inserts them (see bev_map.cu). The scan's
+// map takes the ground pixels that join it (joinsGroundMap(), `band`).
+void buildGroundMap(const DeviceScan& scan, const GroundBand& band, const BevProjection& projection,
+                    float same_surface_distance, const DeviceBev& ground, const CellCompaction& compaction,
+                    cudaStream_t stream);
 // The point counts of `model` and `scan_ground` are read on the device: nothing waits for them.
 void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const BevProjection& projection,
                      const Rigid3f& scan_from_model, const ModelFusion& fusion, const DeviceBev& fused,
