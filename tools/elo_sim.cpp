@@ -87,6 +87,11 @@ std::string usage() {
          "  --beam-elevation-error DEG\n"
          "                       standard deviation in degrees of each laser's constant elevation error\n"
          "                       (default 0); points are still reported along the nominal elevations\n"
+         "  --lower-block-rise M\n"
+         "                       the lasers of the lower half of the field (the HDL-64E's lower block)\n"
+         "                       fire from M metres below where the points say, so that the road they\n"
+         "                       reach near the sensor reads M higher (default 0; KITTI's HDL-64E reads\n"
+         "                       it 0.02-0.04 higher)\n"
          "  --mirror 0|1         1: the drive in the world's mirror image (y -> -y; the sensor turns the\n"
          "                       other way), left turns made right ones (default 0); not with\n"
          "                       --time-convention azimuth\n"
@@ -134,8 +139,8 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
-      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--threads", "--format", "--time-convention",
-      "--mirror", "--gait", "--stamp-rounding", "--truth-time-offset", "--imu", "--imu-rate"};
+      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--lower-block-rise", "--threads", "--format",
+      "--time-convention", "--mirror", "--gait", "--stamp-rounding", "--truth-time-offset", "--imu", "--imu-rate"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -242,6 +247,9 @@ Options parseOptions(int argc, char** argv) {
   if (const auto error = take("--beam-elevation-error")) {
     spec.lidar.beam_elevation_error = elo::tools::parseNumber<double>("--beam-elevation-error", *error);
     if (spec.lidar.beam_elevation_error < 0.0) throw UsageError("--beam-elevation-error must not be negative");
+  }
+  if (const auto rise = take("--lower-block-rise")) {
+    spec.lidar.lower_block_rise = elo::tools::parseNumber<double>("--lower-block-rise", *rise);
   }
   if (const auto mirror = take("--mirror")) {
     if (*mirror != "0" && *mirror != "1") throw UsageError("--mirror expects 0 or 1");

@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -69,9 +70,13 @@ std::vector<Lidar::Beam> Lidar::drawBeams(const SensorConfig& sensor, const Lida
   const bool miscalibrated = options.beam_range_bias > 0.0 || options.beam_elevation_error > 0.0;
   Rng rng(unit_seed);
   std::vector<Beam> beams;
-  for (const float table_elevation : beamElevations(sensor)) {
+  const std::vector<float> elevations = beamElevations(sensor);
+  const float middle = 0.5f * (*std::max_element(elevations.begin(), elevations.end()) +
+                               *std::min_element(elevations.begin(), elevations.end()));
+  for (const float table_elevation : elevations) {
     const double nominal = table_elevation;
     Beam beam;
+    if (table_elevation < middle) beam.height = -options.lower_block_rise;
     beam.nominal = Eigen::Vector2d(std::cos(nominal), std::sin(nominal));
     double actual = nominal;
     if (miscalibrated) {
@@ -118,7 +123,7 @@ std::vector<Lidar::Return> Lidar::castAll(const RayCaster& scene, const std::vec
       const Eigen::Isometry3d& pose = poses.size() == 1 ? poses.front() : poses[step];
       if (hidden_by_vehicle_[static_cast<size_t>(step) * beams + beam]) continue;
       const Eigen::Vector3d local = actualDirection(beam, step);
-      const Ray ray{pose.translation(), pose.linear() * local};
+      const Ray ray{pose * Eigen::Vector3d(0.0, 0.0, beams_[beam].height), pose.linear() * local};
       const auto hit = scene.cast(ray, sensor_.max_range);
       if (!hit || hit->reflectivity <= 0.0f) continue;  // sky, or glass that mirrors the beam away
       Return& result = returns[static_cast<size_t>(step) * beams + beam];

@@ -15,9 +15,12 @@
 namespace elo::test {
 
 // Runs one odometry per config over the simulated drive, every scan through all of them, and evaluates
-// each trajectory against the truth at the scans' reference instants.
+// each trajectory against the truth at the scans' reference instants, over segments of `segment_lengths`
+// starting every `start_step` scans.
 inline std::vector<TrajectoryEvaluation> evaluateOnDrive(const sim::SimulationSpec& spec,
-                                                         const std::vector<Config>& configs) {
+                                                         const std::vector<Config>& configs,
+                                                         const std::vector<double>& segment_lengths = kittiSegmentLengths(),
+                                                         size_t start_step = kKittiStartFrameStep) {
   const sim::Simulation simulation(spec);
   std::vector<std::unique_ptr<Odometry>> runs;
   for (const Config& config : configs) runs.push_back(std::make_unique<Odometry>(config));
@@ -35,7 +38,9 @@ inline std::vector<TrajectoryEvaluation> evaluateOnDrive(const sim::SimulationSp
   }
   std::vector<TrajectoryEvaluation> evaluations;
   const std::string name = sim::worldName(spec.world) + "/" + sim::trajectoryName(spec.trajectory);
-  for (const auto& estimate : estimates) evaluations.push_back(evaluateTrajectory(name, truth, estimate));
+  for (const auto& estimate : estimates) {
+    evaluations.push_back(evaluateTrajectory(name, truth, estimate, segment_lengths, start_step));
+  }
   return evaluations;
 }
 

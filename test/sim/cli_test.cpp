@@ -56,7 +56,8 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
 TEST(EloSimCli, WritesASequence) {
   const elo::test::TempDirectory directory;
   EXPECT_EQ(runTool("--world parking --trajectory uturn --frames 3 --sensor vlp16 --seed 9 --noise 0.01 "
-                    "--dropout 0.05 --deskewed 0 --moving-cars 2 --beam-range-bias 0.01 --beam-elevation-error 0.05 --gait walk "
+                    "--dropout 0.05 --deskewed 0 --moving-cars 2 --beam-range-bias 0.01 --beam-elevation-error 0.05 "
+                    "--lower-block-rise 0.03 --gait walk "
                     "--threads 2 --output " + directory.file("seq")),
             0);
   for (const std::string file : {"velodyne/000000.bin", "velodyne/000002.bin", "poses.txt", "times.txt", "calib.txt"}) {

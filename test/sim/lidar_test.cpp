@@ -471,6 +471,34 @@ TEST(Lidar, EachLaserFiresOffItsNominalElevation) {
   }
 }
 
+// The lower block of a unit with lower_block_rise fires from below the sensor's origin while its points
+// are computed from the origin, along the nominal elevations: on a flat road its rings lie that much
+// higher, the upper block's where the road is.
+TEST(Lidar, TheLowerBlockReadsTheRoadHigh) {
+  constexpr double kRise = 0.03;
+  LidarOptions options = exactOptions();
+  options.lower_block_rise = kRise;
+  const SensorConfig sensor = exactHdl64();
+  const Lidar lidar(sensor, options, 1);
+  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+  const std::vector<double> nominal = elevationsOf(sensor);
+  const double middle = 0.5 * (*std::max_element(nominal.begin(), nominal.end()) +
+                               *std::min_element(nominal.begin(), nominal.end()));
+  size_t lower = 0;
+  size_t upper = 0;
+  for (size_t i = 0; i < scan.cloud.size(); ++i) {
+    const Eigen::Vector3d point = scan.cloud.points[i].cast<double>();
+    const double beam = nominal[scan.cloud.ring[i]];
+    const bool in_lower_block = beam < middle;
+    lower += in_lower_block;
+    upper += !in_lower_block;
+    EXPECT_NEAR(point.z(), -kSensorHeight + (in_lower_block ? kRise : 0.0), 1e-4) << "ring " << scan.cloud.ring[i];
+    EXPECT_NEAR(std::asin(point.z() / point.norm()), beam, 1e-5);
+  }
+  EXPECT_GT(lower, 10000u);
+  EXPECT_GT(upper, 10000u);
+}
+
 TEST(Lidar, RejectsUnusableSensors) {
   SensorConfig sensor = exactSensor();
   sensor.azimuth_steps = 0;

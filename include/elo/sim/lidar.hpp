@@ -54,6 +54,11 @@ struct LidarOptions {
   // these standard deviations (m and degrees), drawn once per unit; both off by default.
   double beam_range_bias = 0.0;
   double beam_elevation_error = 0.0;
+  // The lasers of the lower half of the field (the HDL-64E's lower block) fire from this much lower (m)
+  // than the points say, so that everything they see reads that much higher: the road near the sensor,
+  // which only they reach, lies that much above the road farther out, as it does by 2-4 cm on KITTI's
+  // HDL-64E (docs/real_drives.md). 0 by default.
+  double lower_block_rise = 0.0;
   // The car the sensor is mounted on, in the sensor frame: beams that meet it return nothing (its
   // surfaces lie inside min_range). Empty: a sensor floating free.
   std::vector<Shape> vehicle_body = roofMountedCar();
@@ -118,6 +123,7 @@ class Lidar {
     Eigen::Vector2d nominal;  // (cos, sin) of the elevation in the sensor's table
     Eigen::Vector2d actual;   // (cos, sin) of the elevation the laser really fires at
     double range_offset = 0.0;  // m that the laser adds to every range it reads
+    double height = 0.0;        // m above the sensor's origin that the laser fires from
   };
   static std::vector<Beam> drawBeams(const SensorConfig& sensor, const LidarOptions& options, uint64_t unit_seed);
   // Unit direction that a firing's ray really takes.
