@@ -75,9 +75,9 @@ struct GroundConfig {
   // the road 0.1-0.3 m apart, where 5 degrees allows 1-2 cm: less than the range noise puts between
   // them, so without it half of the road within 5 m is labelled non-ground (docs/ground_segmentation.md).
   double rise_tolerance = 0.03;
-  // Ground points nearer the sensor than this (m) stay out of the scan's ground map, so out of the ground
-  // term and the ground model; they are still ground, not non-ground. 0: all of them. KITTI's HDL-64E sees
-  // the road within 10 m 2-4 cm higher than the road beyond, beam by beam (docs/real_drives.md).
+  // Within this range (m) of the sensor, every point of the ground band is ground whatever its slope, and
+  // stays out of the scan's ground map: out of both terms and both models. 0: off. KITTI's HDL-64E reads
+  // the road within 10 m 2-4 cm higher than the road beyond (docs/real_drives.md).
   double min_range = 0.0;
 };
 

@@ -131,7 +131,7 @@ std::vector<Parameter> parameters(Config& c) {
       bindField("ground.rise_tolerance", g.rise_tolerance,
                 "rise allowed between column neighbours on top of delta_theta's, m (range noise)"),
       bindField("ground.min_range", g.min_range,
-                "ground points nearer the sensor stay out of the ground map (ground term and model), m; 0: none"),
+                "within it the ground band is ground and out of both terms (the near road), m; 0: off"),
       bindChoice("normals.method", n.method,
                  {{NormalMethod::range_adaptive, "range_adaptive"},
                   {NormalMethod::eigen, "eigen"},

@@ -301,7 +301,8 @@ TEST(GroundSegmentation, MinRangeKeepsTheNearBandOutOfBothTermsAndChangesNothing
       continue;
     }
     if (vertex.z() <= band.lowest || vertex.z() >= band.highest) continue;
-    EXPECT_EQ(gated_scan.label[pixel], PixelLabel::ground) << "pixel " << pixel << " in the band, " << vertex.norm() << " m";
+    EXPECT_EQ(gated_scan.label[pixel], PixelLabel::ground)
+        << "pixel " << pixel << " in the band, " << vertex.norm() << " m away";
     const bool on_road = gated.truth.surface[gated_scan.point_index[pixel]] == Surface::ground;
     near_road += on_road;
     near_objects_taken_out += !on_road && whole_scan.label[pixel] == PixelLabel::nonground;

@@ -17,10 +17,9 @@ namespace elo::test {
 // Runs one odometry per config over the simulated drive, every scan through all of them, and evaluates
 // each trajectory against the truth at the scans' reference instants, over segments of `segment_lengths`
 // starting every `start_step` scans.
-inline std::vector<TrajectoryEvaluation> evaluateOnDrive(const sim::SimulationSpec& spec,
-                                                         const std::vector<Config>& configs,
-                                                         const std::vector<double>& segment_lengths = kittiSegmentLengths(),
-                                                         size_t start_step = kKittiStartFrameStep) {
+inline std::vector<TrajectoryEvaluation> evaluateOnDrive(
+    const sim::SimulationSpec& spec, const std::vector<Config>& configs,
+    const std::vector<double>& segment_lengths = kittiSegmentLengths(), size_t start_step = kKittiStartFrameStep) {
   const sim::Simulation simulation(spec);
   std::vector<std::unique_ptr<Odometry>> runs;
   for (const Config& config : configs) runs.push_back(std::make_unique<Odometry>(config));

@@ -14,9 +14,10 @@ namespace elo::cpu {
 
 std::vector<int32_t> groundPixels(const ScanImage& scan, const GroundBand& band) {
   std::vector<int32_t> pixels;
-  parallelSelect(
-      scan.label.size(),
-      [&](size_t pixel) { return joinsGroundMap(scan.label[pixel], toFloat3(scan.image.vertex[pixel]), band); }, pixels);
+  const auto joins = [&](size_t pixel) {
+    return joinsGroundMap(scan.label[pixel], toFloat3(scan.image.vertex[pixel]), band);
+  };
+  parallelSelect(scan.label.size(), joins, pixels);
   return pixels;
 }
 

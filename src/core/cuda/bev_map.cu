@@ -97,8 +97,8 @@ size_t compactionTiles(size_t sources) { return (sources + kThreads - 1) / kThre
 void buildGroundMap(const DeviceScan& scan, const GroundBand& band, const BevProjection& projection,
                     float same_surface_distance, const DeviceBev& ground, const CellCompaction& compaction,
                     cudaStream_t stream) {
-  cell_compaction::compact(PixelSources{scan, band}, blocksFor(scan.pixels()), projection, same_surface_distance, compaction,
-                           ground, stream);
+  cell_compaction::compact(PixelSources{scan, band}, blocksFor(scan.pixels()), projection, same_surface_distance,
+                           compaction, ground, stream);
 }
 
 void fuseGroundModel(const DeviceBev& model, const DeviceBev& scan_ground, const BevProjection& projection,
