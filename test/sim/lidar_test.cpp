@@ -448,18 +448,22 @@ TEST(Lidar, EachLaserReadsItsOwnConstantRangeOffset) {
   EXPECT_NE(offsets(2, 1), unit_one);
 }
 
+// One sweep of the exact HDL-64E over a flat road, by a unit with the calibration errors of `options`.
+SimulatedScan flatRoadSweep(const LidarOptions& options) {
+  const Lidar lidar(exactHdl64(), options, 1);
+  return lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
+}
+
 // Each laser of a miscalibrated unit fires off its nominal elevation by its own angle while its points
 // are computed along the nominal one: on a flat road every ring lies at its own height.
 TEST(Lidar, EachLaserFiresOffItsNominalElevation) {
   constexpr double kErrorDegrees = 0.1;
   LidarOptions options = exactOptions();
   options.beam_elevation_error = kErrorDegrees;
-  const SensorConfig sensor = exactHdl64();
-  const Lidar lidar(sensor, options, 1);
-  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
-  const std::vector<double> nominal = elevationsOf(sensor);
+  const SimulatedScan scan = flatRoadSweep(options);
+  const std::vector<double> nominal = elevationsOf(exactHdl64());
   // The elevation each ring really fired at, from its exact range to the road, less its nominal one.
-  const std::vector<double> per_ring = constantPerRing(scan, lidar.beamCount(), [&](size_t i) {
+  const std::vector<double> per_ring = constantPerRing(scan, static_cast<int>(nominal.size()), [&](size_t i) {
     return std::asin(-kSensorHeight / scan.cloud.points[i].cast<double>().norm()) - nominal[scan.cloud.ring[i]];
   });
   ASSERT_GT(per_ring.size(), 50u);
@@ -478,10 +482,8 @@ TEST(Lidar, TheLowerBlockReadsTheRoadHigh) {
   constexpr double kRise = 0.03;
   LidarOptions options = exactOptions();
   options.lower_block_rise = kRise;
-  const SensorConfig sensor = exactHdl64();
-  const Lidar lidar(sensor, options, 1);
-  const SimulatedScan scan = lidar.sweep(Scene(std::make_shared<FlatGround>(-kSensorHeight), {}), atOrigin, 0.0, 1);
-  const std::vector<double> nominal = elevationsOf(sensor);
+  const SimulatedScan scan = flatRoadSweep(options);
+  const std::vector<double> nominal = elevationsOf(exactHdl64());
   const double middle = 0.5 * (*std::max_element(nominal.begin(), nominal.end()) +
                                *std::min_element(nominal.begin(), nominal.end()));
   size_t lower = 0;
