@@ -293,7 +293,9 @@ TEST_F(ImuWalk, OffTheSamplesChangeNoPose) {
 }
 
 // Half a second without samples (5.0-5.5 s): the scans whose intervals or sweeps it covers fall back to the
-// LiDAR's prior, counted; none is skipped.
+// LiDAR's prior, counted; none is skipped. The walk tracks on: the registration after the LiDAR's prior
+// overshot a swing makes the next one uninformed (Odometry::priorMissed()); informed, it converged near the
+// overshoot and the walk was lost there (73 %).
 TEST_F(ImuWalk, AGapInTheSamplesFallsBackForTheScansItCovers) {
   Odometry odometry(withImu(spec_->config));
   const ImuRun run = walkWithImu(*simulation_, *samples_, odometry,
@@ -305,6 +307,7 @@ TEST_F(ImuWalk, AGapInTheSamplesFallsBackForTheScansItCovers) {
   EXPECT_GE(fallbacks, 5u);
   EXPECT_LE(fallbacks, 10u);
   EXPECT_EQ(odometry.imuFallbackCounts().count(imu_issue::kGap), 1u);
+  EXPECT_LT(tRelOver10m(run), 3.0);  // measured 0.67 %
 }
 
 // The start search centred on the gyro's rotation (docs/start_in_motion.md): the odometry started on the

@@ -189,6 +189,12 @@ class Odometry {
   // `deskewed`: the velocity the projection deskewed the scan under; returns the one it ends deskewed
   // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
   // `informed`: the guess is the motion prior's, with enough history to trust (MotionModel::informed()).
+  // Whether a registration ended farther from its guess than five robust-kernel scales (0.5 m by default),
+  // a turn counted as the move it makes 10 m away: the motion prior overshot (a swing's peak, a fall back
+  // to the LiDAR's prior), and the next scan's registration, started from a prior as far off, is not
+  // informed: a loose kernel first and no direction held to the prior (registration.hpp). Informed, it
+  // converged near the overshoot, within the bounds, and the track was lost.
+  bool priorMissed(const Eigen::Isometry3d& guess, const Eigen::Isometry3d& registered) const;
   Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, bool informed, double dt, const Vector6d& deskewed,
                              double farthest, FrameResult& result);
   // The registration from the motion prior was refused (a swing the prior could not follow): the scan,
@@ -316,6 +322,8 @@ class Odometry {
   // The velocity of the last accepted registration (twist per second), which carries refused scans; kept
   // when the motion becomes unknown for the search.
   Vector6d held_velocity_ = Vector6d::Zero();
+  // The last accepted registration ended far from its guess (priorMissed()): the next is not informed.
+  bool prior_missed_ = false;
   std::map<std::string, size_t> refusals_;
   size_t refused_in_row_ = 0;
   size_t recoveries_ = 0;
