@@ -179,6 +179,12 @@ class Odometry {
   double secondsSinceFirst(double stamp) const;
   // Resets or restarts when `stamp` breaks the timeline (see process()), saying so in `result`.
   void followTimeline(double stamp, FrameResult& result);
+  // Whether a registration ended farther from its guess than five robust-kernel scales (0.5 m by default),
+  // a turn counted as the move it makes 10 m away: the motion prior overshot (a swing's peak, a fall back
+  // to the LiDAR's prior), and the next scan's registration, started from a prior as far off, is not
+  // informed: a loose kernel first and no direction held to the prior (registration.hpp). Informed, it
+  // converged near the overshoot, within the bounds, and the track was lost.
+  bool priorMissed(const Eigen::Isometry3d& guess, const Eigen::Isometry3d& registered) const;
   // Registers the projected scan from `guess`. After each Gauss-Newton step under the final kernel, up to
   // deskew.rounds times, it deskews the scan again under the motion estimated so far and lets the
   // iterations go on, when that changes the deskew by more than a converged step over the sweep
@@ -189,12 +195,6 @@ class Odometry {
   // `deskewed`: the velocity the projection deskewed the scan under; returns the one it ends deskewed
   // under. The registration is between the scans' reference instants (CloudTimes::reference), `dt` apart.
   // `informed`: the guess is the motion prior's, with enough history to trust (MotionModel::informed()).
-  // Whether a registration ended farther from its guess than five robust-kernel scales (0.5 m by default),
-  // a turn counted as the move it makes 10 m away: the motion prior overshot (a swing's peak, a fall back
-  // to the LiDAR's prior), and the next scan's registration, started from a prior as far off, is not
-  // informed: a loose kernel first and no direction held to the prior (registration.hpp). Informed, it
-  // converged near the overshoot, within the bounds, and the track was lost.
-  bool priorMissed(const Eigen::Isometry3d& guess, const Eigen::Isometry3d& registered) const;
   Vector6d registerAndDeskew(const Eigen::Isometry3d& guess, bool informed, double dt, const Vector6d& deskewed,
                              double farthest, FrameResult& result);
   // The registration from the motion prior was refused (a swing the prior could not follow): the scan,
