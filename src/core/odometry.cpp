@@ -40,8 +40,8 @@ bool Odometry::priorMissed(const Eigen::Isometry3d& guess, const Eigen::Isometry
   // and a simulated car drive with miscalibrated beams changed its poses; at 5, no car drive measured did.
   constexpr double kKernelScales = 5.0;
   const Eigen::Isometry3d miss = guess.inverse() * registered;
-  const double turn = Eigen::AngleAxisd(miss.linear()).angle();
-  return miss.translation().norm() + kLever * turn > kKernelScales * config_.registration.robust_kernel_scale;
+  return miss.translation().norm() + kLever * rotationAngle(miss) >
+         kKernelScales * config_.registration.robust_kernel_scale;
 }
 
 void Odometry::reset() {

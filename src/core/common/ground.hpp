@@ -35,7 +35,7 @@ struct GroundBand {
 
 // Whether `point` lies nearer the sensor than `range`.
 ELO_HOST_DEVICE inline bool withinRange(const Float3& point, float range) {
-  return point.x * point.x + point.y * point.y + point.z * point.z < range * range;
+  return squaredNorm(point) < range * range;
 }
 
 ELO_HOST_DEVICE inline bool gentleSlope(const Float3& a, const Float3& b, const GroundBand& band) {
