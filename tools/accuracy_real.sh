@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Accuracy on the real KITTI-raw drives with ground truth (issue 43, docs/real_drives.md): every drive
 # under DRIVES_DIR (a subdirectory with velodyne/ and poses.txt, as tools/xviz_to_kitti.py writes it) is
-# run with config/kitti.yaml and scored over segments of 10-100 m. Prints two tables:
+# run with config/kitti.yaml and scored over segments of 10-100 m. Prints two tables, each scored against the ground truth twice: at its stamps (OXTS's, rounded to 10 ms)
+# and interpolated to the scans' uniform instants (elo_eval --gt-times; docs/real_drives.md):
 #   - per drive: scans, length, t_rel, r_rel, t_rel_xy, ATE and the error breakdown (elo_eval
 #     --breakdown: heading, pitch, roll in deg/100 m; along-track, signed, cross-track and height in %);
-#     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's row;
+#     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's rows;
 #   - start in motion: runs of 11 scans started at scan 0, every 60th scan and the scan where the car is
 #     fastest (oxts.txt), each scored by the error of its 2nd and 11th pose against the ground truth
 #     rebased to its first scan (elo_eval --start S --pose-errors 1,10).
@@ -42,29 +43,41 @@ mkdir -p "$work"
 table="$work/table.txt"
 : >"$table"
 
-# score DRIVE METHOD POSES: one row of the drive table, from elo_eval's KITTI row and breakdown row.
+# truthAt DRIVE TRUTH: elo_eval's options for the ground truth at its stamps or at the scans' instants.
+truthAt() {
+  if [ "$2" = instants ]; then echo "--gt $1/poses.txt --gt-times $1/times.txt"; else echo "--gt $1/poses.txt"; fi
+}
+
+# score DRIVE METHOD POSES TRUTH: one row of the drive table, from elo_eval's KITTI row and breakdown row.
 score() {
-  local drive=$1 method=$2 poses=$3
-  "$bin/elo_eval" --gt "$drive/poses.txt" --est "$poses" --segments "$segments" --segment-step "$segment_step" --breakdown |
-    awk -v d="$(basename "$drive")" -v m="$method" '
+  local drive=$1 method=$2 poses=$3 truth=$4
+  # shellcheck disable=SC2046  # truthAt's options are words
+  "$bin/elo_eval" $(truthAt "$drive" "$truth") --est "$poses" --segments "$segments" \
+    --segment-step "$segment_step" --breakdown 2>/dev/null |
+    awk -v d="$(basename "$drive")" -v m="$method" -v g="$truth" '
       $1 == "sequence" { table++; next }
       table == 1 { scans = $2; length_m = $3; t = $4; r = $5; ate = $8; txy = $9 }
-      table == 2 { printf "%-6s %-7s %6d %9.1f %8.3f %15.3f %8.3f %7.3f %9.3f %7.3f %7.3f %+8.3f %8.3f %9.3f\n",
-                          d, m, scans, length_m, t, r, txy, ate, $2, $3, $4, $5, $6, $7 }' |
+      table == 2 { printf "%-6s %-7s %-8s %6d %9.1f %8.3f %15.3f %8.3f %7.3f %9.3f %7.3f %7.3f %+8.3f %8.3f %9.3f\n",
+                          d, m, g, scans, length_m, t, r, txy, ate, $2, $3, $4, $5, $6, $7 }' |
     tee -a "$table"
 }
 
-printf '%-6s %-7s %6s %9s %8s %15s %8s %7s %9s %7s %7s %8s %8s %9s\n' drive method scans length_m 't_rel_%' \
+# The ground truth at the scans' instants needs the stamps, times.txt.
+truths() { if [ -f "$1/times.txt" ]; then echo stamps instants; else echo stamps; fi; }
+
+printf '%-6s %-7s %-8s %6s %9s %8s %15s %8s %7s %9s %7s %7s %8s %8s %9s\n' drive method truth scans length_m 't_rel_%' \
   'r_rel_deg/100m' 't_xy_%' ATE_m heading pitch roll 'along_%' 'cross_%' 'height_%' | tee -a "$table"
 for drive in "${drives[@]}"; do
   name=$(basename "$drive")
   "$bin/elo_run" --input "$drive" --output "$work/$name.txt" --config "$config" --mode "$mode" \
     --threads "$threads" --quiet >"$work/$name.log"
-  score "$drive" "elo-$mode" "$work/$name.txt"
   if [ -n "${KISS_RUN:-}" ]; then
     "$KISS_RUN" "$drive/velodyne" --output "$work/${name}_kiss.txt" --threads "$threads" >"$work/${name}_kiss.log"
-    score "$drive" kiss-icp "$work/${name}_kiss.txt"
   fi
+  for truth in $(truths "$drive"); do
+    score "$drive" "elo-$mode" "$work/$name.txt" "$truth"
+    [ -z "${KISS_RUN:-}" ] || score "$drive" kiss-icp "$work/${name}_kiss.txt" "$truth"
+  done
 done
 echo "(segments of $segments m starting at every scan; heading, pitch, roll in deg/100m, mean absolute;" \
   "along-track signed: + the estimate travels too far)" | tee -a "$table"
@@ -80,7 +93,15 @@ starts() {
   fi
 }
 
-printf '\n%-6s %7s %9s %15s %16s\n' drive start 'speed_m/s' '2nd_scan_err_m' '11th_scan_err_m' | tee -a "$table"
+# poseErrors DRIVE START POSES TRUTH: the errors of the 2nd and the 11th pose.
+poseErrors() {
+  # shellcheck disable=SC2046  # truthAt's options are words
+  "$bin/elo_eval" $(truthAt "$1" "$4") --est "$3" --start "$2" --pose-errors 1,$((start_frames - 1)) 2>/dev/null |
+    awk '$2 == "pose" { table = 1; next } table { printf "%s ", $3 }'
+}
+
+printf '\n%-6s %7s %9s %17s %17s %19s %19s\n' drive start 'speed_m/s' '2nd_scan_stamps_m' '11th_scan_stamps_m' \
+  '2nd_scan_instants_m' '11th_scan_instants_m' | tee -a "$table"
 for drive in "${drives[@]}"; do
   name=$(basename "$drive")
   scans=$(find "$drive/velodyne" -name '*.bin' | wc -l)
@@ -89,12 +110,12 @@ for drive in "${drives[@]}"; do
     "$bin/elo_run" --input "$drive" --output "$poses" --config "$config" --mode "$mode" --threads "$threads" \
       --quiet --start "$start" --frames "$start_frames" >"$work/${name}_start_$start.log"
     speed=$( [ -f "$drive/oxts.txt" ] && awk -v s="$start" 'NR - 1 == s { print $7 }' "$drive/oxts.txt" || echo nan)
-    "$bin/elo_eval" --gt "$drive/poses.txt" --est "$poses" --start "$start" --pose-errors 1,$((start_frames - 1)) |
-      awk -v d="$name" -v s="$start" -v v="$speed" '
-        $2 == "pose" { table = 1; next }
-        table && $2 == 1 { second = $3 }
-        table && $2 > 1 { printf "%-6s %7d %9.1f %15.3f %16.3f\n", d, s, v, second, $3 }' |
-      tee -a "$table"
+    at_instants="nan nan"
+    [ -f "$drive/times.txt" ] && at_instants=$(poseErrors "$drive" "$start" "$poses" instants)
+    # shellcheck disable=SC2046,SC2086  # two numbers each
+    printf '%-6s %7d %9.1f %17.3f %17.3f %19.3f %19.3f\n' "$name" "$start" "$speed" \
+      $(poseErrors "$drive" "$start" "$poses" stamps) $at_instants | tee -a "$table"
   done
 done
-echo "(error: translation of (gt_S^-1 gt_S+k)^-1 (est_0^-1 est_k), k = 1 and $((start_frames - 1)))" | tee -a "$table"
+echo "(error: translation of (gt_S^-1 gt_S+k)^-1 (est_0^-1 est_k), k = 1 and $((start_frames - 1)); against the" \
+  "ground truth at its stamps and at the scans' uniform instants)" | tee -a "$table"

@@ -14,6 +14,7 @@
 #include "elo/eval/map_entropy.hpp"
 #include "elo/eval/plot.hpp"
 #include "elo/eval/trajectory_error.hpp"
+#include "elo/eval/uniform_instants.hpp"
 #include "elo/io/io_error.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/io/sequence.hpp"
@@ -27,7 +28,7 @@ constexpr int kExitBadInput = 2;
 
 const char* const kUsage =
     "usage: elo_eval --gt GT --est EST [--segments L,...] [--segment-step N] [--breakdown] [--start S] [--pose-errors K,...]\n"
-    "                [--plot PNG] [--tum]\n"
+    "                [--gt-times TIMES] [--plot PNG] [--tum]\n"
     "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
     "       elo_eval --est EST --reverse REV\n"
     "\n"
@@ -59,6 +60,11 @@ const char* const kUsage =
     "  --pose-errors K,...\n"
     "               also print the error of each estimate pose K in the frame of its pose 0, against the\n"
     "               ground truth's likewise (m, deg): what a run started in motion gets wrong at first\n"
+    "  --gt-times TIMES\n"
+    "               the ground truth's stamps (a times.txt, one a pose): score against the ground truth\n"
+    "               interpolated to the instants of the line fitted to them, the instants of a sensor turning\n"
+    "               at a steady rate. KITTI-raw's stamps are OXTS's, rounded to 10 ms, up to 0.1 m of travel\n"
+    "               off the scans' (docs/real_drives.md). GT must be a KITTI pose file\n"
     "  --map-entropy SCANS\n"
     "               the scans EST was estimated from (a directory as elo_run reads, one pose per scan): builds\n"
     "               the map of their points at 3..30 m and prints its mean map entropy (nats, lower is\n"
@@ -84,6 +90,7 @@ struct Options {
   bool breakdown = false;
   std::optional<size_t> start;  // --start: the estimate covers the ground truth from this pose on
   std::vector<size_t> pose_errors;
+  std::optional<std::string> ground_truth_times;  // --gt-times
 };
 
 using elo::tools::UsageError;
@@ -119,6 +126,8 @@ Options parseArguments(int argc, char** argv) {
       options.start = arguments.number<size_t>();
     } else if (arguments.is("--pose-errors")) {
       options.pose_errors = elo::tools::parseNumberList<size_t>("--pose-errors", arguments.value());
+    } else if (arguments.is("--gt-times")) {
+      options.ground_truth_times = arguments.value();
     } else {
       arguments.rejectFlag();
     }
@@ -129,6 +138,9 @@ Options parseArguments(int argc, char** argv) {
   }
   if (options.ground_truth.empty() && (options.breakdown || options.start || !options.pose_errors.empty())) {
     throw UsageError("--breakdown, --start and --pose-errors compare with the ground truth: --gt is required");
+  }
+  if (options.ground_truth_times && (options.tum || fs::is_directory(options.ground_truth))) {
+    throw UsageError("--gt-times gives the stamps of one KITTI pose file: --gt must be one, without --tum");
   }
   if ((options.map_entropy_scans || options.reverse) && fs::is_directory(options.estimate)) {
     throw UsageError("--map-entropy and --reverse score one trajectory: --est must be a file");
@@ -194,6 +206,21 @@ std::vector<Eigen::Isometry3d> groundTruthFrom(const std::vector<Eigen::Isometry
           ground_truth.begin() + static_cast<std::ptrdiff_t>(start + poses)};
 }
 
+// The ground truth in `path`, sampled at the stamps in `times_path`, at the uniform instants fitted to
+// them (--gt-times).
+std::vector<Eigen::Isometry3d> atUniformInstants(const std::vector<Eigen::Isometry3d>& ground_truth,
+                                                 const std::string& path, const std::string& times_path) {
+  try {
+    const std::vector<double> stamps = elo::readTimes(times_path);
+    const elo::UniformInstants fit = elo::fitUniformInstants(stamps);
+    std::cerr << "elo_eval: the ground truth interpolated to uniform instants, a scan every " << fit.period_s
+              << " s; its stamps were up to " << 1000.0 * fit.largest_offset_s << " ms off them\n";
+    return elo::interpolatePoses(ground_truth, stamps, fit.instants);
+  } catch (const std::invalid_argument& error) {
+    throw elo::IoError("'" + path + "' at the stamps of '" + times_path + "': " + error.what());
+  }
+}
+
 void printHeader() {
   std::printf("%-10s %8s %11s %9s %16s %12s %11s %9s %12s\n", "sequence", "frames", "length(m)", "t_rel(%)",
               "r_rel(deg/100m)", "RPE_trans(m)", "RPE_rot(deg)", "ATE(m)", "t_rel_xy(%)");
@@ -237,6 +264,9 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
                                         std::vector<PoseErrorRow>& pose_errors) {
   const std::vector<Eigen::Isometry3d> estimate = readTrajectory(files.estimate, options.tum);
   std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
+  if (options.ground_truth_times) {
+    ground_truth = atUniformInstants(ground_truth, files.ground_truth, *options.ground_truth_times);
+  }
   if (options.start) ground_truth = groundTruthFrom(ground_truth, *options.start, estimate.size(), files.ground_truth);
   elo::TrajectoryEvaluation evaluation;
   try {

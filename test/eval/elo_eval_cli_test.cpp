@@ -1,6 +1,7 @@
 // The elo_eval command line, run as a user runs it.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -137,6 +138,43 @@ TEST_F(EloEvalCli, StartAndPoseErrorsScoreARunStartedMidDrive) {
                                              directory_.file("first.txt") + " --start 0 --pose-errors 10");
   EXPECT_EQ(from_zero.exit_code, 0) << from_zero.output;
   EXPECT_TRUE(contains(from_zero.output, "first          10          0.0000")) << from_zero.output;
+}
+
+// KITTI-raw's stamps: a sensor scanning every 0.1035 s, each scan stamped with the 10 ms OXTS sample
+// nearest. The estimate is exact at the scans' instants; the ground truth, at 20 m/s, is taken at the
+// stamps, up to 0.1 m off. --gt-times scores against the ground truth moved to the instants.
+TEST_F(EloEvalCli, GroundTruthTimesMoveItToTheScansInstants) {
+  std::vector<Eigen::Isometry3d> truth_at_stamps;
+  std::vector<Eigen::Isometry3d> exact;
+  std::string stamps;
+  for (int i = 0; i < 40; ++i) {
+    const double instant = 0.0031 + 0.1035 * i;
+    const double stamp = std::round(instant * 100.0) / 100.0;
+    stamps += std::to_string(stamp) + "\n";
+    truth_at_stamps.push_back(test::translation(Eigen::Vector3d(20.0 * stamp, 0, 0)));
+    exact.push_back(test::translation(Eigen::Vector3d(20.0 * instant, 0, 0)));
+  }
+  writeKittiPoses(directory_.file("truth.txt"), truth_at_stamps);
+  writeKittiPoses(directory_.file("exact.txt"), exact);
+  test::writeText(directory_.file("times.txt"), stamps);
+  const std::string files = "--gt " + directory_.file("truth.txt") + " --est " + directory_.file("exact.txt");
+  // Pose 1's translation error, from the --pose-errors table.
+  const auto pose_1_error = [](const std::string& output) {
+    return std::stod(fieldsOfRow(output.substr(output.find("translation(m)")), "exact ").at(2));
+  };
+  const double at_stamps = pose_1_error(runEloEval(files + " --pose-errors 1").output);
+  EXPECT_NEAR(at_stamps, 20.0 * (0.11 - 0.1035), 1e-4) << "scan 1 stamped 0.11 s, 6.5 ms late";
+  const CommandResult moved = runEloEval(files + " --gt-times " + directory_.file("times.txt") + " --pose-errors 1");
+  EXPECT_EQ(moved.exit_code, 0) << moved.output;
+  EXPECT_TRUE(contains(moved.output, "interpolated to uniform instants")) << moved.output;
+  EXPECT_LT(pose_1_error(moved.output), 0.002) << moved.output;
+
+  test::writeText(directory_.file("short_times.txt"), "0.0\n0.1\n");
+  const CommandResult too_few = runEloEval(files + " --gt-times " + directory_.file("short_times.txt"));
+  EXPECT_EQ(too_few.exit_code, 2);
+  EXPECT_TRUE(contains(too_few.output, "40 poses for 2 stamps")) << too_few.output;
+  EXPECT_EQ(runEloEval(files + " --gt-times /nonexistent/times.txt").exit_code, 2);
+  EXPECT_EQ(runEloEval(files + " --tum --gt-times " + directory_.file("times.txt")).exit_code, 2);
 }
 
 TEST_F(EloEvalCli, TumFiles) {
