@@ -64,4 +64,10 @@ std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool 
   return played;
 }
 
+void reverseSweepTimes(PointCloud& cloud) {
+  for (float& time : cloud.time) time = -time;
+}
+
+void reverseSweepDirection(SensorConfig& sensor) { sensor.clockwise = !sensor.clockwise; }
+
 }  // namespace elo

@@ -195,6 +195,17 @@ TEST(PlayOrder, AReverseRunPlaysLastToFirstWithTimeStillAdvancingByTheRecordedIn
   expectPlayed(playOrder(sequence, 1, true, 2), {6, 5}, {0.0, 0.11});
 }
 
+TEST(PlayOrder, AReverseRunMirrorsEachSweep) {
+  PointCloud cloud;
+  cloud.time = {-0.05f, 0.0f, 0.03f};
+  reverseSweepTimes(cloud);
+  EXPECT_EQ(cloud.time, (std::vector<float>{0.05f, 0.0f, -0.03f}));
+  SensorConfig sensor;
+  ASSERT_TRUE(sensor.clockwise);
+  reverseSweepDirection(sensor);
+  EXPECT_FALSE(sensor.clockwise);
+}
+
 TEST(Sequence, RealHdl64Drive) {
   const std::string path = std::string(ELO_SHARED_DATA) + "/real/hdl64_drive_a";
   if (!fs::is_directory(path)) {

@@ -58,7 +58,9 @@ options:
   --stride K           play every K-th scan from the first: a faster drive, or dropped frames
                        (default 1); score it against every K-th ground-truth pose
   --reverse            play the scans last to first, the route driven backwards (stamps mirrored
-                       so time still advances); elo_eval --reverse compares it with a forward run
+                       so time still advances, and each sweep: its per-point times, or the way a
+                       sensor timed by azimuth turns); elo_eval --reverse compares it with a forward
+                       run. Not with imu.enabled
   --timing CSV         per-frame stage times, iterations, deskew rounds, inlier counts and degeneracy
   --tum FILE           also write the trajectory in TUM format (stamp x y z qx qy qz qw; a bag's
                        stamps are its clouds' header stamps)
@@ -164,6 +166,11 @@ Config loadConfig(const Options& options) {
     elo::setFromString(*parameter, text);
   }
   elo::validate(config);
+  if (options.reverse) {
+    // The IMU's samples would have to be played backwards too, their rates and forces mirrored.
+    if (config.imu.enabled) throw UsageError("--reverse cannot take an IMU: run it with imu.enabled false");
+    elo::reverseSweepDirection(config.sensor);
+  }
   return config;
 }
 

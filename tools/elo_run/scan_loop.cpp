@@ -79,6 +79,7 @@ ScanRead ScanLoop::readPlayed(const PlayedScan& played) {
   if (read.scan) {
     non_finite_points_ += read.scan->non_finite_points;
     read.scan->cloud.stamp = played.stamp;
+    if (options_.reverse) elo::reverseSweepTimes(read.scan->cloud);
     if (options_.prefetch) session_.prefetch(read.scan->cloud);
   }
   return read;
