@@ -25,6 +25,7 @@ CpuBackend::CpuBackend(const Config& config)
     : config_(config),
       spherical_(SphericalProjection::fromConfig(config.sensor)),
       bev_(BevProjection::fromConfig(config.bev)),
+      ground_band_(GroundBand::fromConfig(config.ground)),
       arena_(arenaThreads(config.runtime.threads)) {
   for (float elevation : ringElevations(config.sensor)) ring_rows_.push_back(spherical_.rowOfElevation(elevation));
   scan_.resize(spherical_.rows, spherical_.cols);
@@ -69,9 +70,9 @@ void CpuBackend::segmentGround() {
     if (config_.registration.terms == CostTerms::spherical_all) {
       labelAllNonground(scan_);
     } else {
-      cpu::segmentGround(config_.ground, scan_);
+      cpu::segmentGround(ground_band_, scan_);
     }
-    ground_pixels_ = groundPixels(scan_, GroundBand::fromConfig(config_.ground));
+    ground_pixels_ = groundPixels(scan_, ground_band_);
   });
 }
 

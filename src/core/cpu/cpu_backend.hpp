@@ -39,6 +39,7 @@ class CpuBackend final : public Backend {
   Config config_;
   SphericalProjection spherical_;
   BevProjection bev_;
+  GroundBand ground_band_;  // the ground band of config_.ground, built once
   std::vector<int> ring_rows_;
   tbb::task_arena arena_;
 

@@ -7,8 +7,7 @@
 
 namespace elo::cpu {
 
-void segmentGround(const GroundConfig& config, ScanImage& scan) {
-  const GroundBand band = GroundBand::fromConfig(config);
+void segmentGround(const GroundBand& band, ScanImage& scan) {
   const LabelledPixels pixels(scan);
   parallelFor(static_cast<size_t>(pixels.cols), [&](size_t col) { segmentColumn(pixels, static_cast<int>(col), band); });
 }

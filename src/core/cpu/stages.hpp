@@ -36,7 +36,7 @@ void deskewScan(const SweepVelocity& applied, const SweepVelocity& velocity, Sca
 void deskewTurnedScan(const SweepVelocity& applied, const SweepVelocity& velocity, ScanImage& scan);
 
 // ground_segmentation.cpp: labels occupied pixels ground or non-ground, column by column.
-void segmentGround(const GroundConfig& config, ScanImage& scan);
+void segmentGround(const GroundBand& band, ScanImage& scan);
 // Every occupied pixel non-ground (the "spherical, all points" variant of Table II).
 void labelAllNonground(ScanImage& scan);
 
