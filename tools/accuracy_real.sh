@@ -6,6 +6,8 @@
 #   - per drive: scans, length, t_rel, r_rel, t_rel_xy, ATE and the error breakdown (elo_eval
 #     --breakdown: heading, pitch, roll in deg/100 m; along-track, signed, cross-track and height in %);
 #     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's rows;
+#   - without the ground truth: the gap between ELO's run and a run over the same scans driven backwards
+#     (elo_run --reverse, elo_eval --reverse), which OXTS's errors do not enter;
 #   - start in motion: runs of 11 scans started at scan 0, every 60th scan and the scan where the car is
 #     fastest (oxts.txt), each scored by the error of its 2nd and 11th pose against the ground truth
 #     rebased to its first scan (elo_eval --start S --pose-errors 1,10).
@@ -81,6 +83,17 @@ for drive in "${drives[@]}"; do
 done
 echo "(segments of $segments m starting at every scan; heading, pitch, roll in deg/100m, mean absolute;" \
   "along-track signed: + the estimate travels too far)" | tee -a "$table"
+
+printf '\n%-6s %9s %12s %12s %10s\n' drive length_m gap_m gap_deg 'gap_%' | tee -a "$table"
+for drive in "${drives[@]}"; do
+  name=$(basename "$drive")
+  "$bin/elo_run" --input "$drive" --output "$work/${name}_reverse.txt" --config "$config" --mode "$mode" \
+    --threads "$threads" --quiet --reverse >"$work/${name}_reverse.log"
+  "$bin/elo_eval" --est "$work/$name.txt" --reverse "$work/${name}_reverse.txt" |
+    awk -v d="$name" '{ printf "%-6s %9.1f %12.4f %12.4f %10.3f\n", d, $11, $3, $5, 100 * $3 / $11 }' | tee -a "$table"
+done
+echo "(forward-backward gap: the run's last pose times the reverse run's, no ground truth; errors that" \
+  "change sign with the direction of travel, as a scale error does, cancel in it)" | tee -a "$table"
 
 # starts DRIVE SCANS: scan 0, every 60th scan, and the scan where the car is fastest, of those followed
 # by 10 more scans.
