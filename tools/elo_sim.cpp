@@ -110,6 +110,10 @@ std::string usage() {
          "  --stamp-rounding S   record the stamps rounded to S seconds (times.txt, the scans, the bag), as\n"
          "                       KITTI-raw's are to 0.01; the ground truth stays at the true instants\n"
          "                       (default 0: exact)\n"
+         "  --truth-at instants|stamps\n"
+         "                       where the ground truth is taken: at each scan's true instant (default), or\n"
+         "                       at its recorded stamp, as KITTI-raw's OXTS poses are (with --stamp-rounding;\n"
+         "                       elo_eval --gt-times moves it back to the instants)\n"
          "  --truth-time-offset S\n"
          "                       record the ground truth S seconds after each scan's stamp (poses.txt, the\n"
          "                       bag's), as KITTI-raw's OXTS poses are off its scans' (default 0)\n"
@@ -140,7 +144,8 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
       "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--lower-block-rise", "--threads", "--format",
-      "--time-convention", "--mirror", "--gait", "--stamp-rounding", "--truth-time-offset", "--imu", "--imu-rate"};
+      "--time-convention", "--mirror", "--gait", "--stamp-rounding", "--truth-at", "--truth-time-offset", "--imu",
+      "--imu-rate"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -271,6 +276,12 @@ Options parseOptions(int argc, char** argv) {
   if (const auto rounding = take("--stamp-rounding")) {
     spec.stamp_rounding = elo::tools::parseNumber<double>("--stamp-rounding", *rounding);
     if (!(spec.stamp_rounding >= 0.0)) throw UsageError("--stamp-rounding must not be negative");
+  }
+  if (const auto truth_at = take("--truth-at")) {
+    if (*truth_at != "instants" && *truth_at != "stamps") {
+      throw UsageError("--truth-at expects instants or stamps, got '" + *truth_at + "'");
+    }
+    spec.truth_at_recorded_stamps = *truth_at == "stamps";
   }
   if (const auto offset = take("--truth-time-offset")) {
     spec.truth_time_offset = elo::tools::parseNumber<double>("--truth-time-offset", *offset);

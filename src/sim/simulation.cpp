@@ -65,7 +65,10 @@ double Simulation::recordedStamp(int frame) const {
 
 Eigen::Isometry3d Simulation::sensorPose(int frame) const { return poseAt(stamp(frame)); }
 
-Eigen::Isometry3d Simulation::recordedTruth(int frame) const { return poseAt(stamp(frame) + spec_.truth_time_offset); }
+Eigen::Isometry3d Simulation::recordedTruth(int frame) const {
+  const double instant = spec_.truth_at_recorded_stamps ? recordedStamp(frame) : stamp(frame);
+  return poseAt(instant + spec_.truth_time_offset);
+}
 
 Eigen::Isometry3d Simulation::poseAt(double time) const {
   const Eigen::Isometry3d pose = trajectory_->poseAt(time);

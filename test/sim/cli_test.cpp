@@ -48,6 +48,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --stamp-rounding -0.01" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --truth-time-offset nan" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --truth-time-offset 10ms" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --truth-at oxts" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --bag" + out), 2);  // --bag without a file
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2"), 2);               // no output
   EXPECT_FALSE(std::filesystem::exists(directory.file("seq")));

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 
 #include "../io/temp_directory.hpp"
+#include "elo/eval/uniform_instants.hpp"
 #include "elo/io/kitti.hpp"
 #include "elo/sim/simulation.hpp"
 #include "elo/sim/trajectory.hpp"
@@ -205,6 +207,39 @@ TEST(Simulation, TheRecordedTruthIsTakenTheTruthTimeOffsetAfterEachStamp) {
   }
   EXPECT_GT(largest_rotation_error, 1e-5) << "the curves turn: the offset shows";
   EXPECT_LE(largest_rotation_error, largest_bound + 1e-12);
+}
+
+// KITTI-raw's ground truth, taken at stamps rounded to 10 ms from a sensor turning at 9.66 Hz
+// (SimulationSpec::truth_at_recorded_stamps): the sensor's pose at each recorded stamp, up to 5 ms of
+// travel off the scan's; the line fitted to the stamps and the truth interpolated to it (elo_eval
+// --gt-times) give back the poses at the scans' instants.
+TEST(Simulation, TheTruthAtTheRoundedStampsIsMovedBackToTheScansInstantsByTheFittedLine) {
+  SimulationSpec spec;
+  spec.trajectory = TrajectoryKind::curves;
+  spec.frames = 300;
+  spec.config.sensor.rotation_rate_hz = 9.66;
+  spec.stamp_rounding = 0.01;
+  spec.truth_at_recorded_stamps = true;
+  const Simulation simulation(spec);
+  std::vector<double> stamps;
+  std::vector<Eigen::Isometry3d> recorded;
+  double largest_offset = 0.0;
+  for (int frame = 0; frame < spec.frames; ++frame) {
+    stamps.push_back(simulation.recordedStamp(frame));
+    recorded.push_back(simulation.recordedTruth(frame));
+    ASSERT_TRUE(recorded.back().isApprox(simulation.trajectory().poseAt(stamps.back()), 0.0)) << frame;
+    largest_offset = std::max(largest_offset,
+                              (recorded.back().translation() - simulation.sensorPose(frame).translation()).norm());
+  }
+  EXPECT_GT(largest_offset, 0.03) << "the stamps are rounded by up to 5 ms";
+  const std::vector<Eigen::Isometry3d> moved = interpolatePoses(recorded, stamps, fitUniformInstants(stamps).instants);
+  double largest_error = 0.0;
+  for (int frame = 0; frame < spec.frames; ++frame) {
+    largest_error = std::max(largest_error, (moved[frame].translation() - simulation.sensorPose(frame).translation()).norm());
+  }
+  std::cout << "truth at the rounded stamps up to " << largest_offset << " m off the scans', moved back to "
+            << largest_error << " m" << std::endl;
+  EXPECT_LT(largest_error, 0.005);
 }
 
 TEST(SensorTrajectory, DrivenPosesAreFollowedInXY) {

@@ -34,8 +34,13 @@ struct SimulationSpec {
   // a vehicle.
   Gait gait;
   // Seconds the scans' recorded stamps are rounded to (0: exact), as KITTI-raw's times.txt rounds them to
-  // 10 ms: the scans are still taken a sweep apart, and the ground truth is at the true instants.
+  // 10 ms: the scans are still taken a sweep apart, and the ground truth is at the true instants unless
+  // truth_at_recorded_stamps.
   double stamp_rounding = 0.0;
+  // The recorded ground truth taken at each scan's recorded (rounded) stamp instead of its true instant,
+  // as KITTI-raw's OXTS poses are the 100 Hz samples at its rounded stamps: up to half the rounding of
+  // travel off the scan (docs/real_drives.md).
+  bool truth_at_recorded_stamps = false;
   // Seconds by which the recorded ground truth is taken after each scan's stamp (0: at it), as KITTI-raw's
   // OXTS poses are off the scans' stamps (about -12 ms on drive 0005, docs/real_drives.md): a turn of
   // w rad/s then reads as w times this of rotation error at each end of a segment. Clamped to the drive.
@@ -57,7 +62,8 @@ class Simulation {
   double recordedStamp(int frame) const;
   Eigen::Isometry3d sensorPose(int frame) const;  // in the world frame, at the frame's reference instant
   // The ground truth the frame is recorded with: the sensor's pose SimulationSpec::truth_time_offset after
-  // its reference instant, in the world frame.
+  // its reference instant, or after its recorded stamp with SimulationSpec::truth_at_recorded_stamps, in
+  // the world frame.
   Eigen::Isometry3d recordedTruth(int frame) const;
   SimulatedScan scan(int frame) const;
 
