@@ -20,7 +20,7 @@ DEB_PACKAGES := build-essential cmake catkin python3-catkin-pkg \
   libroscpp-dev libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev \
   libpcl-ros-dev libpcl-conversions-dev librostest-dev python3-rostest libsensor-msgs-dev \
   libnav-msgs-dev librosbag-dev python3-rosbag rosout python3-roslaunch python3-rosmaster \
-  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev
+  libdiagnostic-updater-dev libstd-srvs-dev libgeometry-msgs-dev tf2-tools rviz libsqlite3-dev python3-numpy
 
 .PHONY: deps build test test-long compat compat-poses test-sanitize test-asan test-tsan test-baseline test-aarch64 deps-aarch64 fuzz \
   bench demo accuracy accuracy-real soak rviz-screenshot gpu-check clean

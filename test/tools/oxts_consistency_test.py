@@ -1,0 +1,78 @@
+#!/usr/bin/python3
+"""tools/oxts_consistency.py on a synthetic drive: a car on a circle at 10 m/s turning at 0.05 rad/s,
+its OXTS yaw rate exact. The ground truth agrees with the yaw rate and travels along its heading; an
+odometry that turns 0.01 deg a scan too far is 0.5 deg off the yaw rate over a window of 50 scans."""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+TOOL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "oxts_consistency.py")
+SCANS = 120
+PERIOD = 0.1
+SPEED = 10.0
+YAW_RATE = 0.05
+
+
+def circle_poses(extra_yaw_per_scan=0.0):
+    poses = []
+    for k in range(SCANS):
+        heading = YAW_RATE * PERIOD * k
+        radius = SPEED / YAW_RATE
+        pose = np.eye(4)
+        turn = heading + np.radians(extra_yaw_per_scan) * k
+        pose[:2, :2] = [[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]]
+        pose[:2, 3] = [radius * np.sin(heading), radius * (1.0 - np.cos(heading))]
+        poses.append(pose[:3, :].reshape(-1))
+    return np.array(poses)
+
+
+def rows_of(output):
+    """The four figures of each row after the header, by the trajectory's name (a file's base name)."""
+    rows = {}
+    for line in output.splitlines()[1:]:
+        words = line.split()
+        rows[os.path.basename(" ".join(words[:-4]))] = [float(w) for w in words[-4:]]
+    return rows
+
+
+class OxtsConsistency(unittest.TestCase):
+    def test_exact_drive_and_an_odometry_that_turns_too_far(self):
+        with tempfile.TemporaryDirectory() as drive:
+            np.savetxt(os.path.join(drive, "poses.txt"), circle_poses())
+            np.savetxt(os.path.join(drive, "times.txt"), PERIOD * np.arange(SCANS))
+            oxts = np.zeros((SCANS, 9))
+            oxts[:, 6] = SPEED
+            oxts[:, 8] = YAW_RATE
+            np.savetxt(os.path.join(drive, "oxts.txt"), oxts)
+            estimate = os.path.join(drive, "turns_too_far.txt")
+            np.savetxt(estimate, circle_poses(extra_yaw_per_scan=0.01))
+            done = subprocess.run([sys.executable, TOOL, drive, estimate], capture_output=True, text=True)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            rows = rows_of(done.stdout)
+            truth, odometry = rows["ground truth"], rows["turns_too_far.txt"]
+            self.assertAlmostEqual(truth[0], 0.0, places=6)  # turn - yaw rate, mean
+            self.assertAlmostEqual(truth[2], 0.0, places=6)  # travel - heading, mean
+            self.assertAlmostEqual(odometry[0], 0.5, places=6)
+            self.assertAlmostEqual(odometry[1], 0.5, places=6)
+
+    def test_a_trajectory_of_other_scans_is_refused(self):
+        with tempfile.TemporaryDirectory() as drive:
+            np.savetxt(os.path.join(drive, "poses.txt"), circle_poses())
+            np.savetxt(os.path.join(drive, "times.txt"), PERIOD * np.arange(SCANS))
+            np.savetxt(os.path.join(drive, "oxts.txt"), np.zeros((SCANS, 9)))
+            short = os.path.join(drive, "short.txt")
+            np.savetxt(short, circle_poses()[:100])
+            done = subprocess.run([sys.executable, TOOL, drive, short], capture_output=True, text=True)
+            self.assertEqual(done.returncode, 2)
+            self.assertIn("100 poses for 120 OXTS samples", done.stderr)
+            missing = subprocess.run([sys.executable, TOOL, os.path.join(drive, "nowhere")], capture_output=True,
+                                     text=True)
+            self.assertEqual(missing.returncode, 2)
+
+
+if __name__ == "__main__":
+    unittest.main()

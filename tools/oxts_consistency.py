@@ -1,0 +1,96 @@
+#!/usr/bin/python3
+"""How far a real drive's OXTS ground truth agrees with OXTS's own yaw rate, and trajectories with both.
+
+Usage (Debian's python3 with python3-numpy):
+  oxts_consistency.py DRIVE_DIR [POSES ...]
+    DRIVE_DIR  a drive as tools/xviz_to_kitti.py writes it (poses.txt, times.txt, oxts.txt)
+    POSES      trajectories of the same scans (KITTI poses, elo_run's or another odometry's)
+Prints, for the ground truth and each trajectory, two figures that need nothing but OXTS itself
+(docs/real_drives.md, "What limits the figures"):
+  turn - yaw rate   over windows of 50 scans (one starting every 5th scan): the heading change the
+                    trajectory makes, minus OXTS's yaw rate (its rate about the vehicle's up axis,
+                    oxts.txt) integrated over the stamps; mean and rms, deg. OXTS's heading leaving
+                    its own yaw rate is the ground truth's heading error, or the yaw rate's.
+  travel - heading  over windows of 5 scans: the angle between the direction of travel and the heading
+                    (half the window's turn taken off), mean and standard deviation, deg. A car's is a
+                    steady mounting angle plus what the sensor's lever arm gets from the yaw rate; a
+                    ground truth whose positions wander shows in its spread.
+"""
+import os
+import sys
+
+import numpy as np
+
+TURN_WINDOW = 50
+TRAVEL_WINDOW = 5
+WINDOW_STEP = 5
+
+
+def read_poses(path):
+    rows = np.loadtxt(path, ndmin=2).reshape(-1, 3, 4)
+    poses = np.tile(np.eye(4), (len(rows), 1, 1))
+    poses[:, :3, :] = rows
+    return poses
+
+
+def yaw_deg(rotation):
+    return np.degrees(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
+
+def relative(poses, i, j):
+    return np.linalg.inv(poses[i]) @ poses[j]
+
+
+def integrated_yaw_rate_deg(drive):
+    """OXTS's yaw rate (rad/s, oxts.txt's last column) integrated over the stamps, deg from scan 0."""
+    rate = np.degrees(np.loadtxt(os.path.join(drive, "oxts.txt"), ndmin=2)[:, 8])
+    stamps = np.loadtxt(os.path.join(drive, "times.txt"), ndmin=1)
+    return np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(stamps))])
+
+
+def turn_minus_yaw_rate(poses, yaw_rate):
+    starts = range(0, len(poses) - TURN_WINDOW, WINDOW_STEP)
+    return np.array([yaw_deg(relative(poses, i, i + TURN_WINDOW)[:3, :3]) - (yaw_rate[i + TURN_WINDOW] - yaw_rate[i])
+                     for i in starts])
+
+
+def travel_minus_heading(poses):
+    angles = []
+    for i in range(0, len(poses) - TRAVEL_WINDOW, TRAVEL_WINDOW):
+        step = relative(poses, i, i + TRAVEL_WINDOW)
+        if np.linalg.norm(step[:2, 3]) < 0.5:  # standing still: no direction of travel
+            continue
+        travel = np.degrees(np.arctan2(step[1, 3], step[0, 3]))
+        angles.append(travel - yaw_deg(step[:3, :3]) / 2.0)
+    return np.array(angles)
+
+
+def main(argv):
+    if len(argv) < 2 or argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0 if len(argv) >= 2 else 2
+    drive = argv[1]
+    try:
+        yaw_rate = integrated_yaw_rate_deg(drive)
+        trajectories = [("ground truth", read_poses(os.path.join(drive, "poses.txt")))]
+        trajectories += [(path, read_poses(path)) for path in argv[2:]]
+    except (OSError, ValueError) as error:
+        print(f"oxts_consistency: {error}", file=sys.stderr)
+        return 2
+    print(f"{'trajectory':<40} {'turn - yaw rate: mean':>22} {'rms':>7} {'travel - heading: mean':>23} {'sd':>6}")
+    for name, poses in trajectories:
+        if len(poses) != len(yaw_rate):
+            print(f"oxts_consistency: {name} has {len(poses)} poses for {len(yaw_rate)} OXTS samples", file=sys.stderr)
+            return 2
+        if len(poses) <= TURN_WINDOW:
+            print(f"oxts_consistency: {len(poses)} scans, too few for windows of {TURN_WINDOW}", file=sys.stderr)
+            return 2
+        turn = turn_minus_yaw_rate(poses, yaw_rate)
+        travel = travel_minus_heading(poses)
+        print(f"{name:<40} {turn.mean():>+22.3f} {np.sqrt(np.mean(turn ** 2)):>7.3f} "
+              f"{travel.mean():>+23.2f} {travel.std():>6.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
