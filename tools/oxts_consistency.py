@@ -15,6 +15,10 @@ Prints, for the ground truth and each trajectory, two figures that need nothing 
                     (half the window's turn taken off), mean and standard deviation, deg. A car's is a
                     steady mounting angle plus what the sensor's lever arm gets from the yaw rate; a
                     ground truth whose positions wander shows in its spread.
+  climb - pitch     the same in the vertical: the angle of the direction of travel above the sensor's
+                    x axis (half the window's change of pitch taken off). A car's is steady but for its
+                    body pitching on the springs; a ground truth whose altitude wanders shows in its
+                    spread, and in the height error elo_eval --breakdown gives.
 """
 import os
 import sys
@@ -54,15 +58,22 @@ def turn_minus_yaw_rate(poses, yaw_rate):
                      for i in starts])
 
 
-def travel_minus_heading(poses):
-    angles = []
+def pitch_deg(rotation):
+    return np.degrees(np.arctan2(-rotation[2, 0], rotation[0, 0]))
+
+
+def travel_off_axes(poses):
+    """Per window of TRAVEL_WINDOW scans: the direction of travel off the heading and above the x axis."""
+    sideways, upwards = [], []
     for i in range(0, len(poses) - TRAVEL_WINDOW, TRAVEL_WINDOW):
         step = relative(poses, i, i + TRAVEL_WINDOW)
-        if np.linalg.norm(step[:2, 3]) < 0.5:  # standing still: no direction of travel
+        horizontal = np.linalg.norm(step[:2, 3])
+        if horizontal < 0.5:  # standing still: no direction of travel
             continue
-        travel = np.degrees(np.arctan2(step[1, 3], step[0, 3]))
-        angles.append(travel - yaw_deg(step[:3, :3]) / 2.0)
-    return np.array(angles)
+        sideways.append(np.degrees(np.arctan2(step[1, 3], step[0, 3])) - yaw_deg(step[:3, :3]) / 2.0)
+        # The x axis pitches nose down for a positive pitch: half the window's pitch change turns it up.
+        upwards.append(np.degrees(np.arctan2(step[2, 3], horizontal)) + pitch_deg(step[:3, :3]) / 2.0)
+    return np.array(sideways), np.array(upwards)
 
 
 def main(argv):
@@ -77,7 +88,8 @@ def main(argv):
     except (OSError, ValueError) as error:
         print(f"oxts_consistency: {error}", file=sys.stderr)
         return 2
-    print(f"{'trajectory':<40} {'turn - yaw rate: mean':>22} {'rms':>7} {'travel - heading: mean':>23} {'sd':>6}")
+    print(f"{'trajectory':<40} {'turn - yaw rate: mean':>22} {'rms':>7} {'travel - heading: mean':>23} {'sd':>6} "
+          f"{'climb - pitch: mean':>20} {'sd':>6}")
     for name, poses in trajectories:
         if len(poses) != len(yaw_rate):
             print(f"oxts_consistency: {name} has {len(poses)} poses for {len(yaw_rate)} OXTS samples", file=sys.stderr)
@@ -86,9 +98,9 @@ def main(argv):
             print(f"oxts_consistency: {len(poses)} scans, too few for windows of {TURN_WINDOW}", file=sys.stderr)
             return 2
         turn = turn_minus_yaw_rate(poses, yaw_rate)
-        travel = travel_minus_heading(poses)
+        sideways, upwards = travel_off_axes(poses)
         print(f"{name:<40} {turn.mean():>+22.3f} {np.sqrt(np.mean(turn ** 2)):>7.3f} "
-              f"{travel.mean():>+23.2f} {travel.std():>6.2f}")
+              f"{sideways.mean():>+23.2f} {sideways.std():>6.2f} {upwards.mean():>+20.2f} {upwards.std():>6.2f}")
     return 0
 
 

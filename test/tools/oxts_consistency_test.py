@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """tools/oxts_consistency.py on a synthetic drive: a car on a circle at 10 m/s turning at 0.05 rad/s,
-its OXTS yaw rate exact. The ground truth agrees with the yaw rate and travels along its heading; an
-odometry that turns 0.01 deg a scan too far is 0.5 deg off the yaw rate over a window of 50 scans."""
+its OXTS yaw rate exact. The ground truth agrees with the yaw rate and travels along its heading and its
+x axis; an odometry that turns 0.01 deg a scan too far is 0.5 deg off the yaw rate over a window of 50
+scans, and one that climbs 1 m in 100 with its x axis level travels 0.573 deg above it."""
 import os
 import subprocess
 import sys
@@ -17,7 +18,7 @@ SPEED = 10.0
 YAW_RATE = 0.05
 
 
-def circle_poses(extra_yaw_per_scan=0.0):
+def circle_poses(extra_yaw_per_scan=0.0, grade=0.0):
     poses = []
     for k in range(SCANS):
         heading = YAW_RATE * PERIOD * k
@@ -25,17 +26,17 @@ def circle_poses(extra_yaw_per_scan=0.0):
         pose = np.eye(4)
         turn = heading + np.radians(extra_yaw_per_scan) * k
         pose[:2, :2] = [[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]]
-        pose[:2, 3] = [radius * np.sin(heading), radius * (1.0 - np.cos(heading))]
+        pose[:3, 3] = [radius * np.sin(heading), radius * (1.0 - np.cos(heading)), grade * SPEED * PERIOD * k]
         poses.append(pose[:3, :].reshape(-1))
     return np.array(poses)
 
 
 def rows_of(output):
-    """The four figures of each row after the header, by the trajectory's name (a file's base name)."""
+    """The six figures of each row after the header, by the trajectory's name (a file's base name)."""
     rows = {}
     for line in output.splitlines()[1:]:
         words = line.split()
-        rows[os.path.basename(" ".join(words[:-4]))] = [float(w) for w in words[-4:]]
+        rows[os.path.basename(" ".join(words[:-6]))] = [float(w) for w in words[-6:]]
     return rows
 
 
@@ -48,16 +49,22 @@ class OxtsConsistency(unittest.TestCase):
             oxts[:, 6] = SPEED
             oxts[:, 8] = YAW_RATE
             np.savetxt(os.path.join(drive, "oxts.txt"), oxts)
-            estimate = os.path.join(drive, "turns_too_far.txt")
-            np.savetxt(estimate, circle_poses(extra_yaw_per_scan=0.01))
-            done = subprocess.run([sys.executable, TOOL, drive, estimate], capture_output=True, text=True)
+            turning = os.path.join(drive, "turns_too_far.txt")
+            np.savetxt(turning, circle_poses(extra_yaw_per_scan=0.01))
+            climbing = os.path.join(drive, "climbs_level.txt")
+            np.savetxt(climbing, circle_poses(grade=0.01))
+            done = subprocess.run([sys.executable, TOOL, drive, turning, climbing], capture_output=True, text=True)
             self.assertEqual(done.returncode, 0, done.stderr)
             rows = rows_of(done.stdout)
-            truth, odometry = rows["ground truth"], rows["turns_too_far.txt"]
+            truth = rows["ground truth"]
             self.assertAlmostEqual(truth[0], 0.0, places=6)  # turn - yaw rate, mean
             self.assertAlmostEqual(truth[2], 0.0, places=6)  # travel - heading, mean
-            self.assertAlmostEqual(odometry[0], 0.5, places=6)
-            self.assertAlmostEqual(odometry[1], 0.5, places=6)
+            self.assertAlmostEqual(truth[4], 0.0, places=6)  # climb - pitch, mean
+            self.assertAlmostEqual(rows["turns_too_far.txt"][0], 0.5, places=6)
+            self.assertAlmostEqual(rows["turns_too_far.txt"][1], 0.5, places=6)
+            self.assertAlmostEqual(rows["climbs_level.txt"][0], 0.0, places=6)
+            # The chord of 5 scans of the circle is a little shorter than its arc: 0.573 deg to 0.01.
+            self.assertAlmostEqual(rows["climbs_level.txt"][4], np.degrees(np.arctan(0.01)), places=2)
 
     def test_a_trajectory_of_other_scans_is_refused(self):
         with tempfile.TemporaryDirectory() as drive:
