@@ -58,14 +58,17 @@ std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool 
   if (reverse && !played.empty()) {
     const double mirror = played.front().stamp + played.back().stamp;
     std::reverse(played.begin(), played.end());
-    for (PlayedScan& scan : played) scan.stamp = mirror - scan.stamp;
+    for (PlayedScan& scan : played) scan = {scan.index, mirror - scan.stamp, true};
   }
   if (max_frames > 0 && played.size() > max_frames) played.resize(max_frames);
   return played;
 }
 
-void reverseSweepTimes(PointCloud& cloud) {
-  for (float& time : cloud.time) time = -time;
+void asPlayed(const PlayedScan& played, PointCloud& cloud) {
+  cloud.stamp = played.stamp;
+  if (played.reversed) {
+    for (float& time : cloud.time) time = -time;
+  }
 }
 
 void reverseSweepDirection(SensorConfig& sensor) { sensor.clockwise = !sensor.clockwise; }

@@ -196,10 +196,19 @@ TEST(PlayOrder, AReverseRunPlaysLastToFirstWithTimeStillAdvancingByTheRecordedIn
 }
 
 TEST(PlayOrder, AReverseRunMirrorsEachSweep) {
-  PointCloud cloud;
-  cloud.time = {-0.05f, 0.0f, 0.03f};
-  reverseSweepTimes(cloud);
-  EXPECT_EQ(cloud.time, (std::vector<float>{0.05f, 0.0f, -0.03f}));
+  TempDirectory directory;
+  const Sequence sequence = writeUnevenlyTimedScans(directory);
+  const std::vector<float> recorded = {-0.05f, 0.0f, 0.03f};
+  PointCloud forward;
+  forward.time = recorded;
+  asPlayed(playOrder(sequence, 1, false).back(), forward);
+  EXPECT_EQ(forward.time, recorded);
+  EXPECT_DOUBLE_EQ(forward.stamp, 0.61);
+  PointCloud reversed;
+  reversed.time = recorded;
+  asPlayed(playOrder(sequence, 1, true).back(), reversed);
+  EXPECT_EQ(reversed.time, (std::vector<float>{0.05f, 0.0f, -0.03f}));
+  EXPECT_DOUBLE_EQ(reversed.stamp, 0.61);
   SensorConfig sensor;
   ASSERT_TRUE(sensor.clockwise);
   reverseSweepDirection(sensor);

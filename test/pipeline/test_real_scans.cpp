@@ -24,7 +24,7 @@ std::vector<Eigen::Isometry3d> runPlayed(const Sequence& sequence, const std::ve
   std::vector<Eigen::Isometry3d> poses;
   for (const PlayedScan& scan : played) {
     PointCloud cloud = sequence.load(scan.index);
-    cloud.stamp = scan.stamp;
+    asPlayed(scan, cloud);
     const FrameResult result = odometry.process(cloud);
     EXPECT_TRUE(result.processed) << "scan " << scan.index << ": " << result.skip_reason;
     EXPECT_TRUE(result.pose.matrix().allFinite()) << "scan " << scan.index;

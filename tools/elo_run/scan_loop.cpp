@@ -78,8 +78,7 @@ ScanRead ScanLoop::readPlayed(const PlayedScan& played) {
   report_.addReading(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   if (read.scan) {
     non_finite_points_ += read.scan->non_finite_points;
-    read.scan->cloud.stamp = played.stamp;
-    if (options_.reverse) elo::reverseSweepTimes(read.scan->cloud);
+    elo::asPlayed(played, read.scan->cloud);
     if (options_.prefetch) session_.prefetch(read.scan->cloud);
   }
   return read;

@@ -73,28 +73,30 @@ std::string chooseCloudTopic(const std::string& bag, const std::vector<BagTopic>
 std::string chooseImuTopic(const std::string& bag, const std::vector<BagTopic>& topics, const std::string& imu_type,
                            const std::string& requested);
 
-// One scan of a run: which scan, and the stamp the run gives it.
+// One scan of a run: which scan, the stamp the run gives it, and whether the run plays it reversed.
 struct PlayedScan {
   size_t index;
   double stamp;
+  bool reversed = false;
 };
 
 // The scans a run plays, in order: every `stride`-th scan from scan `first` (a faster drive, or dropped
 // frames; a drive cut mid-way) and, with `reverse`, last to first; at most `max_frames` of them (0: all).
 // A reverse run drives the route backwards rather than back in time: its stamps are mirrored about the
-// played span, so they still advance by the recorded intervals; each sweep is mirrored too
-// (reverseSweepTimes, reverseSweepDirection). Throws std::invalid_argument for a stride of 0.
+// played span, so they still advance by the recorded intervals, and each sweep is mirrored too
+// (asPlayed(), reverseSweepDirection()). Throws std::invalid_argument for a stride of 0.
 std::vector<PlayedScan> playOrder(const ScanSource& source, size_t stride, bool reverse, size_t max_frames = 0,
                                   size_t first = 0);
 
-// A reverse run's sweep runs backwards in time as well: within the sweep the sensor moved forward along
-// the route, which the reverse run drives backwards, so a sweep deskewed with its recorded per-point
-// times is smeared twice over instead of straightened (0.5 m of forward-backward gap over 107 m of a
-// real KITTI drive, 17 m over 347 m). Each point's time relative to the stamp changes sign.
-void reverseSweepTimes(PointCloud& cloud);
+// The scan `cloud`, read for `played`, as the run plays it: at the played stamp and, reversed, with its
+// sweep running backwards in time as well. Within the sweep the sensor moved forward along the route,
+// which the reverse run drives backwards, so a sweep deskewed with its recorded per-point times would be
+// smeared twice over instead of straightened (0.5 m of forward-backward gap over 107 m of a real KITTI
+// drive, 17 m over 347 m): each point's time relative to the stamp changes sign.
+void asPlayed(const PlayedScan& played, PointCloud& cloud);
 
-// The same for a sensor whose points are timed by their azimuth (deskew.time_source azimuth): it turns
-// the other way.
+// The same for a sensor whose points are timed by their azimuth (deskew.time_source azimuth): in a
+// reverse run it turns the other way.
 void reverseSweepDirection(SensorConfig& sensor);
 
 }  // namespace elo
