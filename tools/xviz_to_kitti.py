@@ -4,8 +4,9 @@
 Usage (Debian's python3 with python3-numpy):
   xviz_to_kitti.py GIT_DIR PREFIX OUT_DIR
     GIT_DIR  a (bare) git repository holding the converter's output, e.g. a `git clone --bare` of
-             https://github.com/lukaasp/xviz-data (drive 2011_09_26_0001) or
-             https://github.com/yu1218jong/xviz_kitti (drives 0005 and 0027); docs/real_drives.md
+             https://github.com/lukaasp/xviz-data (drive 2011_09_26_0001),
+             https://github.com/yu1218jong/xviz_kitti (drives 0005 and 0027) or
+             https://github.com/GwangRyul/kitti-data (drive 0002, PREFIX "2011_09_26/"); docs/real_drives.md
     PREFIX   the folder inside it that holds 0-frame.json and N-frame.glb, e.g.
              "2011_09_26_drive_0027_sync/" ("" for the repository's root)
 Writes OUT_DIR in the KITTI layout that elo_run reads:

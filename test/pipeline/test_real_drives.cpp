@@ -26,7 +26,7 @@ namespace elo {
 namespace {
 
 const std::vector<double> kSegmentLengths = {10, 20, 50, 100};
-constexpr size_t kSegmentStep = 1;  // a segment starting at every scan: the drives are 108-188 scans long
+constexpr size_t kSegmentStep = 1;  // a segment starting at every scan: the drives are 77-188 scans long
 
 std::string drivesDirectory() {
   const char* from_environment = std::getenv("ELO_REAL_DRIVES");
@@ -142,8 +142,8 @@ TEST_P(RealDriveDrift, StaysWithinTodaysFigures) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Drives, RealDriveDrift,
-                         testing::Values(DriftCase{"0001", 0.424, 0.393}, DriftCase{"0005", 5.054, 1.402},
-                                         DriftCase{"0027", 1.383, 0.224}),
+                         testing::Values(DriftCase{"0001", 0.424, 0.393}, DriftCase{"0002", 0.553, 0.731},
+                                         DriftCase{"0005", 5.054, 1.402}, DriftCase{"0027", 1.383, 0.224}),
                          [](const auto& info) { return std::string("drive_") + info.param.drive; });
 
 // A run started on a moving car: ELO at its first scan knows nothing of the motion, yet its 2nd scan
@@ -197,6 +197,7 @@ TEST_P(StartInMotion, FirstScansFollowTheTruth) {
 INSTANTIATE_TEST_SUITE_P(Drives, StartInMotion,
                          testing::Values(StartCase{"0027", 0}, StartCase{"0027", 60}, StartCase{"0027", 120},
                                          StartCase{"0027", 177}, StartCase{"0001", 0}, StartCase{"0001", 60},
+                                         StartCase{"0002", 0}, StartCase{"0002", 60}, StartCase{"0002", 66},
                                          StartCase{"0005", 0}, StartCase{"0005", 60}, StartCase{"0005", 120},
                                          StartCase{"0005", 143}),
                          [](const auto& info) {
