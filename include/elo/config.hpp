@@ -122,6 +122,11 @@ struct RegistrationConfig {
   // Correspondences at edges and corners carry residuals of centimetres even at the true pose and would
   // bias plain least squares; 0 gives the paper's plain least squares.
   double robust_kernel_scale = 0.1;
+  // A non-ground correspondence whose scan point lies nearer than this (m) weighs its range over it; 0
+  // weighs all alike (the paper). A pixel stands for a patch of surface growing with the square of its
+  // range: weighed alike, a fence or an embankment beside the car outnumbers the scene around it and
+  // held the heading of two real KITTI drives (docs/real_drives.md); config/kitti.yaml sets 45.
+  double near_weight_range = 0.0;
   // A direction of motion whose share of the constraint (eigenvalue of the unit-consistent Hessian, see
   // degeneracy.hpp) is below this is degenerate: it is not solved and keeps the motion prior. 0 turns the
   // handling off. Smallest eigenvalue measured per scan (HDL-64E, simulated unless said): the tunnel

@@ -168,6 +168,8 @@ std::vector<Parameter> parameters(Config& c) {
            "pixels searched around the projective association"),
       bindField("registration.robust_kernel_scale", r.robust_kernel_scale,
                 "Geman-McClure scale for point-to-plane residuals, m; 0 = plain least squares"),
+      bindField("registration.near_weight_range", r.near_weight_range,
+                "a non-ground correspondence nearer than this weighs its range over it, m; 0 = all alike"),
       bindField("registration.degeneracy_threshold", r.degeneracy_threshold,
                 "share of the constraint below which a direction of motion is degenerate and keeps the motion "
                 "prior (scaled Hessian eigenvalue); 0 = off"),
@@ -364,6 +366,7 @@ void validate(const Config& c) {
   require(r.association_radius >= 0 && r.association_radius <= s.image_width / 2, "registration.association_radius",
           "must lie in [0, sensor.image_width / 2]");
   require(r.robust_kernel_scale >= 0.0, "registration.robust_kernel_scale", "must not be negative");
+  require(r.near_weight_range >= 0.0, "registration.near_weight_range", "must not be negative");
   // The six scaled eigenvalues sum to 2, so the smallest is at most 1/3: a threshold that high would find
   // every scan degenerate.
   require(r.degeneracy_threshold >= 0.0 && r.degeneracy_threshold < 1.0 / 3.0, "registration.degeneracy_threshold",

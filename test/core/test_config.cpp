@@ -112,6 +112,9 @@ TEST(Config, ValidateNamesTheImpossibleParameter) {
   config = Config();
   config.registration.association_radius = config.sensor.image_width / 2 + 1;  // would visit columns twice
   EXPECT_NE(message_of(config).find("registration.association_radius"), std::string::npos);
+  config = Config();
+  config.registration.near_weight_range = -1.0;
+  EXPECT_NE(message_of(config).find("registration.near_weight_range"), std::string::npos);
 }
 
 TEST(Config, DeskewKeysSetTheTimeSourceAndTheSweep) {

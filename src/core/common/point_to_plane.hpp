@@ -28,6 +28,24 @@ ELO_HOST_DEVICE inline PointToPlane pointToPlane(const Float3& moved, const Floa
   return {residual, gemanMcClureWeight(residual, kernel_scale), {normal.x, normal.y, normal.z, moment.x, moment.y, moment.z}};
 }
 
+// The weight of a non-ground correspondence for the range of its scan point: range / near_range nearer
+// than near_range (registration.near_weight_range; 0: 1 for all). A pixel stands for a patch of surface
+// growing with the square of its range; weighed alike, the returns of a structure beside the car outnumber
+// the rest of the scene.
+ELO_HOST_DEVICE inline double nearWeight(float range, float near_range) {
+  return range < near_range ? static_cast<double>(range / near_range) : 1.0;
+}
+
+// The term of a non-ground correspondence: pointToPlane() weighed by nearWeight() of `scan_vertex`, the
+// scan point in its own frame.
+ELO_HOST_DEVICE inline PointToPlane nongroundTerm(const Float3& moved, const Float3& model_vertex,
+                                                  const Float3& model_normal, const Float3& scan_vertex,
+                                                  double kernel_scale, float near_range) {
+  PointToPlane term = pointToPlane(moved, model_vertex, model_normal, kernel_scale);
+  term.weight *= nearWeight(norm(scan_vertex), near_range);
+  return term;
+}
+
 // The Gauss-Newton sums of a set of correspondences in the packed form both backends accumulate: the
 // upper triangle of J^T W J row by row (J^T W J is symmetric, so the lower one is its mirror and costs
 // no products), then J^T W e, then the squared error.

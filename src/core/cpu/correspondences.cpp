@@ -53,6 +53,7 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
                        double kernel_scale, const RegistrationConfig& config) {
   const Rigid3f motion = toRigid3f(model_from_scan);
   const CorrespondenceGates gates = CorrespondenceGates::fromConfig(config);
+  const float near_range = static_cast<float>(config.near_weight_range);
   const ModelPixels model_pixels(model);
   const SphericalImage& image = scan.image;
   return deterministicSum<PackedSums>(pixels.size(), [&](size_t begin, size_t end, PackedSums& block_sums) {
@@ -73,7 +74,8 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
             int match = -1;
             if (nongroundMatchAtPixel(model_pixels, motion, point, toFloat3(image.normal[pixels[i]]), row, col, gates,
                                       match)) {
-              sums.add(pointToPlane(point, model_pixels.vertex(match), model_pixels.normal(match), kernel_scale));
+              sums.add(nongroundTerm(point, model_pixels.vertex(match), model_pixels.normal(match),
+                                     toFloat3(image.vertex[pixels[i]]), kernel_scale, near_range));
             }
           });
     }

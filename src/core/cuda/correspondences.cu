@@ -113,7 +113,8 @@ __device__ void addNongroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
                         moved, match)) {
       continue;
     }
-    sums.add(pointToPlane(moved, in.model.vertices[match], in.model.normals[match], in.kernel_scale));
+    sums.add(nongroundTerm(moved, in.model.vertices[match], in.model.normals[match], in.scan.vertices[pixel],
+                           in.kernel_scale, in.near_weight_range));
   }
 }
 

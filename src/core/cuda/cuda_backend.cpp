@@ -409,6 +409,7 @@ NormalEquations CudaBackend::linearizeAgainst(const DeviceModelImage& model, con
   inputs.gates = gates_;
   inputs.motion = toRigid3f(model_from_scan);
   inputs.kernel_scale = kernel_scale;
+  inputs.near_weight_range = static_cast<float>(config_.registration.near_weight_range);
   // The launch writes the sums into host_term_sums_ itself: one synchronisation and no copy.
   cuda::linearize(inputs, {partial_sums_.data(), finished_blocks_.data()}, host_term_sums_.data(), stream_.get());
   synchronize();

@@ -165,6 +165,7 @@ struct LinearizeInputs {
   CorrespondenceGates gates;
   Rigid3f motion;
   double kernel_scale;
+  float near_weight_range;  // registration.near_weight_range (nearWeight())
 };
 // The scratch of linearize(): every block's partial sums, term by term and row by row
 // (kTerms * kPartialRows * kReductionBlocks), and the count of the blocks done, which must be 0 before
