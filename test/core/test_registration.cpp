@@ -37,6 +37,21 @@ TEST(Registration, GaussNewtonRecoversAKnownMotionToAMillimetre) {
   EXPECT_LE(result.registration.weight, 0.7);
 }
 
+// Weighing near correspondences less (registration.near_weight_range) changes how much each one counts,
+// not where the minimum of an exact scene lies; and it does change the sums.
+TEST(Registration, NearWeightingKeepsAnExactSceneExact) {
+  const Eigen::Isometry3d truth = pose(0.6, 0.15, 0.03, 0.3, -0.4, 1.5);
+  Config config;
+  config.registration.near_weight_range = 45.0;
+  const FrameResult weighed = registerPair(config, truth);
+  ASSERT_TRUE(weighed.processed);
+  EXPECT_TRUE(weighed.registration.converged);
+  EXPECT_LT(translationErrorMm(weighed.delta, truth), 1.0);
+  EXPECT_LT(rotationErrorDeg(weighed.delta, truth), 0.01);
+  const FrameResult alike = registerPair(Config(), truth);
+  EXPECT_NE(weighed.delta.matrix(), alike.delta.matrix());
+}
+
 TEST(Registration, EveryTableIIVariantConvergesAndTheGroundTermHelps) {
   // On exact planes the spherical image of all points also finds the motion. Without the ground
   // (non-ground SRI alone) roll and pitch rest on a few car roofs and the estimate is visibly worse:
