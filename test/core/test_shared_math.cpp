@@ -284,13 +284,13 @@ TEST(PointToPlane, ANearCorrespondenceWeighsItsRangeOverTheNearRange) {
   const Float3 moved{10.0f, 2.0f, 0.5f};
   const Float3 vertex{10.1f, 2.0f, 0.4f};
   const Float3 normal{-1.0f, 0.0f, 0.0f};
-  const Float3 scan_vertex{3.0f, 4.0f, 0.0f};  // 5 m from the sensor
+  const float scan_range = 5.0f;
   const PointToPlane plain = pointToPlane(moved, vertex, normal, 0.1);
-  const PointToPlane near = nongroundTerm(moved, vertex, normal, scan_vertex, 0.1, 10.0f);
+  const PointToPlane near = nongroundTerm(moved, vertex, normal, scan_range, 0.1, 10.0f);
   EXPECT_EQ(near.weight, plain.weight * 0.5);
   EXPECT_EQ(near.residual, plain.residual);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(near.jacobian[i], plain.jacobian[i]);
-  EXPECT_EQ(nongroundTerm(moved, vertex, normal, scan_vertex, 0.1, 0.0f).weight, plain.weight);
+  EXPECT_EQ(nongroundTerm(moved, vertex, normal, scan_range, 0.1, 0.0f).weight, plain.weight);
 }
 
 // The CPU's 4-wide accumulator adds each packed value the same products in the same order as the shared

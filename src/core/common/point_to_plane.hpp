@@ -36,13 +36,13 @@ ELO_HOST_DEVICE inline double nearWeight(float range, float near_range) {
   return range < near_range ? static_cast<double>(range / near_range) : 1.0;
 }
 
-// The term of a non-ground correspondence: pointToPlane() weighed by nearWeight() of `scan_vertex`, the
-// scan point in its own frame.
+// The term of a non-ground correspondence: pointToPlane() weighed by nearWeight() of `scan_range`, the
+// range the scan image holds for the point (the norm of its vertex).
 ELO_HOST_DEVICE inline PointToPlane nongroundTerm(const Float3& moved, const Float3& model_vertex,
-                                                  const Float3& model_normal, const Float3& scan_vertex,
-                                                  double kernel_scale, float near_range) {
+                                                  const Float3& model_normal, float scan_range, double kernel_scale,
+                                                  float near_range) {
   PointToPlane term = pointToPlane(moved, model_vertex, model_normal, kernel_scale);
-  term.weight *= nearWeight(norm(scan_vertex), near_range);
+  term.weight *= nearWeight(scan_range, near_range);
   return term;
 }
 

@@ -75,7 +75,7 @@ TermSums nongroundSums(const ScanImage& scan, const std::vector<int32_t>& pixels
             if (nongroundMatchAtPixel(model_pixels, motion, point, toFloat3(image.normal[pixels[i]]), row, col, gates,
                                       match)) {
               sums.add(nongroundTerm(point, model_pixels.vertex(match), model_pixels.normal(match),
-                                     toFloat3(image.vertex[pixels[i]]), kernel_scale, near_range));
+                                     image.range[pixels[i]], kernel_scale, near_range));
             }
           });
     }

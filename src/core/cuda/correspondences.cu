@@ -113,7 +113,7 @@ __device__ void addNongroundTerms(const LinearizeInputs& in, ThreadSums& sums) {
                         moved, match)) {
       continue;
     }
-    sums.add(nongroundTerm(moved, in.model.vertices[match], in.model.normals[match], in.scan.vertices[pixel],
+    sums.add(nongroundTerm(moved, in.model.vertices[match], in.model.normals[match], in.scan.ranges[pixel],
                            in.kernel_scale, in.near_weight_range));
   }
 }
