@@ -87,6 +87,8 @@ std::string usage() {
          "  --beam-elevation-error DEG\n"
          "                       standard deviation in degrees of each laser's constant elevation error\n"
          "                       (default 0); points are still reported along the nominal elevations\n"
+         "  --range-offset M     every laser reads every range M metres long (negative: short), on top of\n"
+         "                       its own --beam-range-bias (default 0)\n"
          "  --lower-block-rise M\n"
          "                       the lasers of the lower half of the field (the HDL-64E's lower block)\n"
          "                       fire from M metres below where the points say, so that the road they\n"
@@ -143,9 +145,9 @@ std::map<std::string, std::string> readFlags(int argc, char** argv) {
   static const std::vector<std::string> known = {
       "--world", "--trajectory", "--poses",    "--frames",      "--output",        "--bag",          "--sensor",
       "--seed",  "--config",     "--noise",    "--dropout",     "--deskewed",      "--moving-cars",  "--foliage-depth",
-      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--lower-block-rise", "--threads", "--format",
-      "--time-convention", "--mirror", "--gait", "--stamp-rounding", "--truth-at", "--truth-time-offset", "--imu",
-      "--imu-rate"};
+      "--mixed-pixels", "--beam-range-bias", "--beam-elevation-error", "--range-offset", "--lower-block-rise",
+      "--threads", "--format", "--time-convention", "--mirror", "--gait", "--stamp-rounding", "--truth-at",
+      "--truth-time-offset", "--imu", "--imu-rate"};
   std::map<std::string, std::string> flags;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -252,6 +254,9 @@ Options parseOptions(int argc, char** argv) {
   if (const auto error = take("--beam-elevation-error")) {
     spec.lidar.beam_elevation_error = elo::tools::parseNumber<double>("--beam-elevation-error", *error);
     if (spec.lidar.beam_elevation_error < 0.0) throw UsageError("--beam-elevation-error must not be negative");
+  }
+  if (const auto offset = take("--range-offset")) {
+    spec.lidar.range_offset = elo::tools::parseNumber<double>("--range-offset", *offset);
   }
   if (const auto rise = take("--lower-block-rise")) {
     spec.lidar.lower_block_rise = elo::tools::parseNumber<double>("--lower-block-rise", *rise);

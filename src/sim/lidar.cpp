@@ -79,8 +79,9 @@ std::vector<Lidar::Beam> Lidar::drawBeams(const SensorConfig& sensor, const Lida
     if (table_elevation < middle) beam.height = -options.lower_block_rise;
     beam.nominal = Eigen::Vector2d(std::cos(nominal), std::sin(nominal));
     double actual = nominal;
+    beam.range_offset = options.range_offset;
     if (miscalibrated) {
-      beam.range_offset = rng.gaussian(0.0, options.beam_range_bias);
+      beam.range_offset += rng.gaussian(0.0, options.beam_range_bias);
       actual += rng.gaussian(0.0, options.beam_elevation_error * M_PI / 180.0);
     }
     beam.actual = Eigen::Vector2d(std::cos(actual), std::sin(actual));

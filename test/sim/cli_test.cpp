@@ -43,6 +43,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --format ply" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-range-bias -0.01" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-elevation-error -1" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --range-offset 5cm" + out), 2);
   EXPECT_EQ(runTool("--world urban --poses /nonexistent/poses.txt" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --gait hop" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --stamp-rounding -0.01" + out), 2);
@@ -58,7 +59,7 @@ TEST(EloSimCli, WritesASequence) {
   const elo::test::TempDirectory directory;
   EXPECT_EQ(runTool("--world parking --trajectory uturn --frames 3 --sensor vlp16 --seed 9 --noise 0.01 "
                     "--dropout 0.05 --deskewed 0 --moving-cars 2 --beam-range-bias 0.01 --beam-elevation-error 0.05 "
-                    "--lower-block-rise 0.03 --gait walk "
+                    "--range-offset -0.02 --lower-block-rise 0.03 --gait walk "
                     "--threads 2 --output " + directory.file("seq")),
             0);
   for (const std::string file : {"velodyne/000000.bin", "velodyne/000002.bin", "poses.txt", "times.txt", "calib.txt"}) {

@@ -448,6 +448,35 @@ TEST(Lidar, EachLaserReadsItsOwnConstantRangeOffset) {
   EXPECT_NE(offsets(2, 1), unit_one);
 }
 
+// A unit whose distance calibration is off as a whole reads every range of every laser long by the same
+// offset; each laser's own offset, when it has one, comes on top of it.
+TEST(Lidar, EveryLaserReadsTheUnitsRangeOffset) {
+  constexpr double kOffset = 0.05;
+  LidarOptions options = exactOptions();
+  options.range_offset = kOffset;
+  const double distance = 12.0;
+  const auto sweepOfWall = [&] {
+    const Lidar lidar(exactHdl64(), options, 1);
+    return lidar.sweep(wallScene(distance), atOrigin, 0.0, 1);
+  };
+  const auto offsetOf = [&](const SimulatedScan& scan, size_t i) {
+    const Eigen::Vector3d point = scan.cloud.points[i].cast<double>();
+    return point.norm() - distance / point.normalized().x();  // along the nominal direction
+  };
+  const SimulatedScan whole = sweepOfWall();
+  ASSERT_GT(whole.cloud.size(), 10000u);
+  for (size_t i = 0; i < whole.cloud.size(); ++i) EXPECT_NEAR(offsetOf(whole, i), kOffset, 1e-4);
+
+  options.beam_range_bias = 0.02;
+  const SimulatedScan both = sweepOfWall();
+  const std::vector<double> per_ring =
+      constantPerRing(both, 64, [&](size_t i) { return offsetOf(both, i); });
+  ASSERT_EQ(per_ring.size(), 64u);
+  const double mean = std::accumulate(per_ring.begin(), per_ring.end(), 0.0) / per_ring.size();
+  EXPECT_NEAR(mean, kOffset, 0.01);  // 64 lasers' own offsets of 2 cm average to within 2.5 mm
+  EXPECT_GT(spread(per_ring), 0.01);
+}
+
 // One sweep of the exact HDL-64E over a flat road, by a unit with the calibration errors of `options`.
 SimulatedScan flatRoadSweep(const LidarOptions& options) {
   const Lidar lidar(exactHdl64(), options, 1);

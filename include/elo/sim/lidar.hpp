@@ -54,6 +54,11 @@ struct LidarOptions {
   // these standard deviations (m and degrees), drawn once per unit; both off by default.
   double beam_range_bias = 0.0;
   double beam_elevation_error = 0.0;
+  // A unit whose distance calibration is off as a whole: every laser reads every range this much long
+  // (m; negative: short), on top of its own offset above. A few centimetres bend the drift wherever the
+  // surfaces near the sensor outnumber the far ones: each is seen from a new angle every scan, so its
+  // points move against the model (docs/real_drives.md). 0 by default.
+  double range_offset = 0.0;
   // The lasers of the lower half of the field (the HDL-64E's lower block) fire from this much lower (m)
   // than the points say, so that everything they see reads that much higher: the road near the sensor,
   // which only they reach, lies that much above the road farther out, as it does by 2-4 cm on KITTI's
