@@ -87,8 +87,8 @@ std::string usage() {
          "  --beam-elevation-error DEG\n"
          "                       standard deviation in degrees of each laser's constant elevation error\n"
          "                       (default 0); points are still reported along the nominal elevations\n"
-         "  --range-offset M     every laser reads every range M metres long (negative: short), on top of\n"
-         "                       its own --beam-range-bias (default 0)\n"
+         "  --range-offset M     every laser reads every range M metres long (negative: short; within\n"
+         "                       [-1, 1]), on top of its own --beam-range-bias (default 0)\n"
          "  --lower-block-rise M\n"
          "                       the lasers of the lower half of the field (the HDL-64E's lower block)\n"
          "                       fire from M metres below where the points say, so that the road they\n"
@@ -257,6 +257,7 @@ Options parseOptions(int argc, char** argv) {
   }
   if (const auto offset = take("--range-offset")) {
     spec.lidar.range_offset = elo::tools::parseNumber<double>("--range-offset", *offset);
+    if (std::abs(spec.lidar.range_offset) > 1.0) throw UsageError("--range-offset must lie within [-1, 1] m");
   }
   if (const auto rise = take("--lower-block-rise")) {
     spec.lidar.lower_block_rise = elo::tools::parseNumber<double>("--lower-block-rise", *rise);

@@ -12,6 +12,7 @@
 namespace elo::sim {
 namespace {
 constexpr double kEchoReferenceRange = 10.0;  // m at which the echo strength equals the intensity
+constexpr double kMaxRangeOffset = 1.0;       // m: a unit off by more reads nonsense, not a calibration error
 
 // The unit vector at `elevation` (cos, sin) and the azimuth of (azimuth_cos, azimuth_sin).
 Eigen::Vector3d atAzimuth(const Eigen::Vector2d& elevation, double azimuth_cos, double azimuth_sin) {
@@ -45,6 +46,9 @@ Lidar::Lidar(const SensorConfig& sensor, const LidarOptions& options, uint64_t u
   }
   if (options.beam_range_bias < 0.0 || options.beam_elevation_error < 0.0) {
     throw std::invalid_argument("beam calibration errors must not be negative");
+  }
+  if (!(std::abs(options.range_offset) <= kMaxRangeOffset)) {
+    throw std::invalid_argument("range offset must lie within +-1 m");
   }
   beams_ = drawBeams(sensor, options, unit_seed);
   if (beams_.empty()) throw std::invalid_argument("sensor '" + sensor.name + "' has no beams");

@@ -44,6 +44,7 @@ TEST(EloSimCli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-range-bias -0.01" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --beam-elevation-error -1" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --range-offset 5cm" + out), 2);
+  EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --range-offset 2" + out), 2);
   EXPECT_EQ(runTool("--world urban --poses /nonexistent/poses.txt" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --gait hop" + out), 2);
   EXPECT_EQ(runTool("--world urban --trajectory straight --frames 2 --stamp-rounding -0.01" + out), 2);

@@ -549,6 +549,11 @@ TEST(Lidar, RejectsUnusableSensors) {
   options = exactOptions();
   options.beam_elevation_error = -0.1;
   EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options = exactOptions();
+  options.range_offset = -1.5;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
+  options.range_offset = NAN;
+  EXPECT_THROW(Lidar(exactSensor(), options), std::invalid_argument);
 }
 
 }  // namespace

@@ -55,9 +55,9 @@ struct LidarOptions {
   double beam_range_bias = 0.0;
   double beam_elevation_error = 0.0;
   // A unit whose distance calibration is off as a whole: every laser reads every range this much long
-  // (m; negative: short), on top of its own offset above. A few centimetres bend the drift wherever the
-  // surfaces near the sensor outnumber the far ones: each is seen from a new angle every scan, so its
-  // points move against the model (docs/real_drives.md). 0 by default.
+  // (m, within +-1; negative: short), on top of its own offset above. 5 cm bend a simulated drive's drift
+  // through the surfaces near the sensor, each seen from a new angle every scan (docs/real_drives.md).
+  // 0 by default.
   double range_offset = 0.0;
   // The lasers of the lower half of the field (the HDL-64E's lower block) fire from this much lower (m)
   // than the points say, so that everything they see reads that much higher: the road near the sensor,
