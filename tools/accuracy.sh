@@ -122,8 +122,8 @@ for variant in registration.terms=fused registration.terms=spherical_all registr
   evaluate urban/ablation hdl64 f2m --set "$variant"
 done
 # Table III in the paper's pipeline, the scan/model normal gate opened from our 30 to 90 degrees: the gate
-# drops the cross product's worst normals, which is what lets it keep up on simulated drives (README,
-# Table III).
+# drops the cross product's worst normals, which is what lets it keep up on simulated drives
+# (docs/accuracy.md, Table III).
 for method in range_adaptive eigen cross_product; do
   evaluate urban/ablation hdl64 f2m --set registration.max_normal_angle_deg=90 --set normals.method=$method
 done
