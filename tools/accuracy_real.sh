@@ -8,11 +8,12 @@
 #     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's rows;
 #   - without the ground truth: the gap between ELO's run and a run over the same scans driven backwards
 #     (elo_run --reverse, elo_eval --reverse), which OXTS's errors do not enter;
-#   - start in motion: runs of 11 scans started at scan 0, every 60th scan and the scan where the car is
-#     fastest (oxts.txt), each scored by the error of its 2nd and 11th pose against the ground truth
-#     rebased to its first scan (elo_eval --start S --pose-errors 1,10).
+#   - start in motion: runs of 11 scans started at scan 0, every 60th scan (START_EVERY) and the scan
+#     where the car is fastest (oxts.txt), each scored by the error of its 2nd and 11th pose against the
+#     ground truth rebased to its first scan (elo_eval --start S --pose-errors 1,10), beside the 11th
+#     pose's error of the drive's own run over the same scans (tracking, no start).
 # Usage:
-#   tools/accuracy_real.sh BUILD_DIR DRIVES_DIR [f2m|f2f]
+#   [START_EVERY=N] [THREADS=N] tools/accuracy_real.sh BUILD_DIR DRIVES_DIR [f2m|f2f]
 # Works in BUILD_DIR/accuracy_real/ (trajectories kept); the tables are also written to
 # BUILD_DIR/accuracy_real/table.txt. Exits 0, saying where it looked, when DRIVES_DIR holds no drive.
 set -euo pipefail
@@ -25,7 +26,7 @@ work="$build/accuracy_real"
 segments=10,20,50,100
 # A segment starts at every scan: these drives are 108-188 scans long, too few for the devkit's every 10th.
 segment_step=1
-start_every=60
+start_every=${START_EVERY:-60}
 start_frames=11
 threads=${THREADS:-2}
 
@@ -118,11 +119,18 @@ poseErrors() {
     awk '$2 == "pose" { table = 1; next } table { printf "%s ", $3 }'
 }
 
-printf '\n%-6s %7s %9s %17s %17s %19s %19s\n' drive start 'speed_m/s' '2nd_scan_stamps_m' '11th_scan_stamps_m' \
-  '2nd_scan_instants_m' '11th_scan_instants_m' | tee -a "$table"
+# trackedSlice DRIVE START: the drive's own run over the start's scans, as a trajectory of its own.
+trackedSlice() {
+  sed -n "$(($2 + 1)),$(($2 + start_frames))p" "$work/$(basename "$1").txt" >"$work/tracked_slice.txt"
+  echo "$work/tracked_slice.txt"
+}
+
+printf '\n%-6s %7s %9s %17s %17s %19s %19s %18s\n' drive start 'speed_m/s' '2nd_scan_stamps_m' '11th_scan_stamps_m' \
+  '2nd_scan_instants_m' '11th_scan_instants_m' '11th_tracking_m' | tee -a "$table"
 for drive in "${drives[@]}"; do
   name=$(basename "$drive")
   scans=$(find "$drive/velodyne" -name '*.bin' | wc -l)
+  truth=$(truths "$drive" | awk '{ print $NF }')
   for start in $(starts "$drive" "$scans" | sort -nu); do
     poses="$work/${name}_start_$start.txt"
     "$bin/elo_run" --input "$drive" --output "$poses" --config "$config" --mode "$mode" --threads "$threads" \
@@ -130,10 +138,12 @@ for drive in "${drives[@]}"; do
     speed=$( [ -f "$drive/oxts.txt" ] && awk -v s="$start" 'NR - 1 == s { print $7 }' "$drive/oxts.txt" || echo nan)
     at_instants="nan nan"
     [ -f "$drive/times.txt" ] && at_instants=$(poseErrors "$drive" "$start" "$poses" instants)
+    tracked=$(poseErrors "$drive" "$start" "$(trackedSlice "$drive" "$start")" "$truth" | awk '{ print $2 }')
     # shellcheck disable=SC2046,SC2086  # two numbers each
-    printf '%-6s %7d %9.1f %17.3f %17.3f %19.3f %19.3f\n' "$name" "$start" "$speed" \
-      $(poseErrors "$drive" "$start" "$poses" stamps) $at_instants | tee -a "$table"
+    printf '%-6s %7d %9.1f %17.3f %17.3f %19.3f %19.3f %18.3f\n' "$name" "$start" "$speed" \
+      $(poseErrors "$drive" "$start" "$poses" stamps) $at_instants "$tracked" | tee -a "$table"
   done
 done
 echo "(error: translation of (gt_S^-1 gt_S+k)^-1 (est_0^-1 est_k), k = 1 and $((start_frames - 1)); against the" \
-  "ground truth at its stamps and at the scans' uniform instants)" | tee -a "$table"
+  "ground truth at its stamps and at the scans' uniform instants; tracking: the drive's run from its first" \
+  "scan over the same scans, at the instants where times.txt gives them)" | tee -a "$table"
