@@ -119,9 +119,9 @@ poseErrors() {
     awk '$2 == "pose" { table = 1; next } table { printf "%s ", $3 }'
 }
 
-# trackedSlice DRIVE START: the drive's own run over the start's scans, as a trajectory of its own.
+# trackedSlice POSES START: a run's poses over the start's scans, as a trajectory of its own.
 trackedSlice() {
-  sed -n "$(($2 + 1)),$(($2 + start_frames))p" "$work/$(basename "$1").txt" >"$work/tracked_slice.txt"
+  sed -n "$(($2 + 1)),$(($2 + start_frames))p" "$1" >"$work/tracked_slice.txt"
   echo "$work/tracked_slice.txt"
 }
 
@@ -138,7 +138,7 @@ for drive in "${drives[@]}"; do
     speed=$( [ -f "$drive/oxts.txt" ] && awk -v s="$start" 'NR - 1 == s { print $7 }' "$drive/oxts.txt" || echo nan)
     at_instants="nan nan"
     [ -f "$drive/times.txt" ] && at_instants=$(poseErrors "$drive" "$start" "$poses" instants)
-    tracked=$(poseErrors "$drive" "$start" "$(trackedSlice "$drive" "$start")" "$truth" | awk '{ print $2 }')
+    tracked=$(poseErrors "$drive" "$start" "$(trackedSlice "$work/$name.txt" "$start")" "$truth" | awk '{ print $2 }')
     # shellcheck disable=SC2046,SC2086  # two numbers each
     printf '%-6s %7d %9.1f %17.3f %17.3f %19.3f %19.3f %18.3f\n' "$name" "$start" "$speed" \
       $(poseErrors "$drive" "$start" "$poses" stamps) $at_instants "$tracked" | tee -a "$table"
