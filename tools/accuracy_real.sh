@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Accuracy on the real KITTI-raw drives with ground truth (issue 43, docs/real_drives.md): every drive
 # under DRIVES_DIR (a subdirectory with velodyne/ and poses.txt, as tools/xviz_to_kitti.py writes it) is
-# run with config/kitti.yaml and scored over segments of 10-100 m. Prints two tables, each scored against the ground truth twice: at its stamps (OXTS's, rounded to 10 ms)
-# and interpolated to the scans' uniform instants (elo_eval --gt-times; docs/real_drives.md):
+# run with config/kitti.yaml and scored over segments of 10-100 m. Prints three tables; those with the
+# ground truth score against it at its stamps (OXTS's, rounded to 10 ms) and interpolated to the scans'
+# uniform instants (elo_eval --gt-times; docs/real_drives.md):
 #   - per drive: scans, length, t_rel, r_rel, t_rel_xy, ATE and the error breakdown (elo_eval
 #     --breakdown: heading, pitch, roll in deg/100 m; along-track, signed, cross-track and height in %);
-#     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's rows;
+#     with KISS_RUN (a kiss_run binary, /work/shared/tools/kiss/setup.sh) also KISS-ICP's rows; on a
+#     drive whose ground truth strays (tools/oxts_consistency.py --strays), a third row over the segments
+#     clear of its strays (elo_eval --exclude-frames);
 #   - without the ground truth: the gap between ELO's run and a run over the same scans driven backwards
 #     (elo_run --reverse, elo_eval --reverse), which OXTS's errors do not enter;
 #   - start in motion: runs of 11 scans started at scan 0, every 60th scan (START_EVERY) and the scan
@@ -48,12 +51,23 @@ table="$work/table.txt"
 
 # elo_eval, its note on the instants it moved the ground truth to left out of the tables; its errors kept.
 evaluate() {
-  "$bin/elo_eval" "$@" 2> >(grep -v 'interpolated to uniform instants' >&2)
+  "$bin/elo_eval" "$@" 2> >(grep -v -e 'interpolated to uniform instants' -e 'are left out' >&2)
 }
 
-# truthAt DRIVE TRUTH: elo_eval's options for the ground truth at its stamps or at the scans' instants.
+# strayingScans DRIVE: the scans where the ground truth's direction of travel strays from what OXTS's own
+# speed and yaw rate give ("A-B,C-D"; nothing where it holds together or oxts.txt is absent).
+strayingScans() {
+  if [ -f "$1/oxts.txt" ]; then "$(dirname "$0")/oxts_consistency.py" --strays "$1" 2>/dev/null; fi
+}
+
+# truthAt DRIVE TRUTH: elo_eval's options for the ground truth at its stamps, at the scans' instants, or
+# at its stamps over the segments clear of its strays.
 truthAt() {
-  if [ "$2" = instants ]; then echo "--gt $1/poses.txt --gt-times $1/times.txt"; else echo "--gt $1/poses.txt"; fi
+  case $2 in
+    instants) echo "--gt $1/poses.txt --gt-times $1/times.txt" ;;
+    clear) echo "--gt $1/poses.txt --exclude-frames $(strayingScans "$1")" ;;
+    *) echo "--gt $1/poses.txt" ;;
+  esac
 }
 
 # score DRIVE METHOD POSES TRUTH: one row of the drive table, from elo_eval's KITTI row and breakdown row.
@@ -70,8 +84,13 @@ score() {
     tee -a "$table"
 }
 
-# The ground truth at the scans' instants needs the stamps, times.txt.
-truths() { if [ -f "$1/times.txt" ]; then echo stamps instants; else echo stamps; fi; }
+# The ground truth at the scans' instants needs the stamps, times.txt; its clear segments a drive where it
+# strays.
+truths() {
+  echo stamps
+  if [ -f "$1/times.txt" ]; then echo instants; fi
+  if [ -n "$(strayingScans "$1")" ]; then echo clear; fi
+}
 
 printf '%-6s %-7s %-8s %6s %9s %8s %15s %8s %7s %9s %7s %7s %8s %8s %9s\n' drive method truth scans length_m 't_rel_%' \
   'r_rel_deg/100m' 't_xy_%' ATE_m heading pitch roll 'along_%' 'cross_%' 'height_%' | tee -a "$table"
@@ -88,7 +107,8 @@ for drive in "${drives[@]}"; do
   done
 done
 echo "(segments of $segments m starting at every scan; heading, pitch, roll in deg/100m, mean absolute;" \
-  "along-track signed: + the estimate travels too far)" | tee -a "$table"
+  "along-track signed: + the estimate travels too far; clear: at the stamps, the segments holding no scan" \
+  "where the ground truth's direction of travel strays, tools/oxts_consistency.py --strays)" | tee -a "$table"
 
 printf '\n%-6s %9s %12s %12s %10s\n' drive length_m gap_m gap_deg 'gap_%' | tee -a "$table"
 for drive in "${drives[@]}"; do
@@ -130,7 +150,8 @@ printf '\n%-6s %7s %9s %17s %17s %19s %19s %18s\n' drive start 'speed_m/s' '2nd_
 for drive in "${drives[@]}"; do
   name=$(basename "$drive")
   scans=$(find "$drive/velodyne" -name '*.bin' | wc -l)
-  truth=$(truths "$drive" | awk '{ print $NF }')
+  tracking_truth=stamps
+  if [ -f "$drive/times.txt" ]; then tracking_truth=instants; fi
   for start in $(starts "$drive" "$scans" | sort -nu); do
     poses="$work/${name}_start_$start.txt"
     "$bin/elo_run" --input "$drive" --output "$poses" --config "$config" --mode "$mode" --threads "$threads" \
@@ -138,7 +159,7 @@ for drive in "${drives[@]}"; do
     speed=$( [ -f "$drive/oxts.txt" ] && awk -v s="$start" 'NR - 1 == s { print $7 }' "$drive/oxts.txt" || echo nan)
     at_instants="nan nan"
     [ -f "$drive/times.txt" ] && at_instants=$(poseErrors "$drive" "$start" "$poses" instants)
-    tracked=$(poseErrors "$drive" "$start" "$(trackedSlice "$work/$name.txt" "$start")" "$truth" | awk '{ print $2 }')
+    tracked=$(poseErrors "$drive" "$start" "$(trackedSlice "$work/$name.txt" "$start")" "$tracking_truth" | awk '{ print $2 }')
     # shellcheck disable=SC2046,SC2086  # two numbers each
     printf '%-6s %7d %9.1f %17.3f %17.3f %19.3f %19.3f %18.3f\n' "$name" "$start" "$speed" \
       $(poseErrors "$drive" "$start" "$poses" stamps) $at_instants "$tracked" | tee -a "$table"

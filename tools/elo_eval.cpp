@@ -28,7 +28,7 @@ constexpr int kExitBadInput = 2;
 
 const char* const kUsage =
     "usage: elo_eval --gt GT --est EST [--segments L,...] [--segment-step N] [--breakdown] [--start S] [--pose-errors K,...]\n"
-    "                [--gt-times TIMES] [--plot PNG] [--tum]\n"
+    "                [--gt-times TIMES] [--exclude-frames A-B,...] [--plot PNG] [--tum]\n"
     "       elo_eval --est EST --map-entropy SCANS [--gt GT ...]\n"
     "       elo_eval --est EST --reverse REV\n"
     "\n"
@@ -65,6 +65,11 @@ const char* const kUsage =
     "               interpolated to the instants of the line fitted to them, the instants of a sensor turning\n"
     "               at a steady rate. KITTI-raw's stamps are OXTS's, rounded to 10 ms, up to 0.1 m of travel\n"
     "               off the scans' (docs/real_drives.md). GT must be a KITTI pose file\n"
+    "  --exclude-frames A-B,...\n"
+    "               leave out of t_rel, r_rel and the breakdown every segment holding one of these frames of\n"
+    "               GT (ranges A-B, both ends included, or single frames; RPE and ATE keep every frame): the\n"
+    "               stretches where the ground truth strays (tools/oxts_consistency.py --strays). GT must be\n"
+    "               one file; with --start the frames are still GT's\n"
     "  --map-entropy SCANS\n"
     "               the scans EST was estimated from (a directory as elo_run reads, one pose per scan): builds\n"
     "               the map of their points at 3..30 m and prints its mean map entropy (nats, lower is\n"
@@ -91,9 +96,19 @@ struct Options {
   std::optional<size_t> start;  // --start: the estimate covers the ground truth from this pose on
   std::vector<size_t> pose_errors;
   std::optional<std::string> ground_truth_times;  // --gt-times
+  std::vector<elo::FrameRange> excluded_frames;   // of the ground-truth file
 };
 
 using elo::tools::UsageError;
+
+// Frame ranges of the ground-truth file as frames of its part from `start` on (--start).
+std::vector<elo::FrameRange> rangesFrom(const std::vector<elo::FrameRange>& ranges, size_t start) {
+  std::vector<elo::FrameRange> shifted;
+  for (const elo::FrameRange& range : ranges) {
+    if (range.last >= start) shifted.push_back({std::max(range.first, start) - start, range.last - start});
+  }
+  return shifted;
+}
 
 Options parseArguments(int argc, char** argv) {
   Options options;
@@ -128,6 +143,12 @@ Options parseArguments(int argc, char** argv) {
       options.pose_errors = elo::tools::parseNumberList<size_t>("--pose-errors", arguments.value());
     } else if (arguments.is("--gt-times")) {
       options.ground_truth_times = arguments.value();
+    } else if (arguments.is("--exclude-frames")) {
+      try {
+        options.excluded_frames = elo::parseFrameRanges(arguments.value());
+      } catch (const std::invalid_argument& error) {
+        throw UsageError(std::string("--exclude-frames ") + error.what());
+      }
     } else {
       arguments.rejectFlag();
     }
@@ -141,6 +162,9 @@ Options parseArguments(int argc, char** argv) {
   }
   if (options.ground_truth_times && (options.tum || fs::is_directory(options.ground_truth))) {
     throw UsageError("--gt-times gives the stamps of one KITTI pose file: --gt must be one, without --tum");
+  }
+  if (!options.excluded_frames.empty() && (options.ground_truth.empty() || fs::is_directory(options.ground_truth))) {
+    throw UsageError("--exclude-frames gives frames of one ground-truth file: --gt must be one");
   }
   if ((options.map_entropy_scans || options.reverse) && fs::is_directory(options.estimate)) {
     throw UsageError("--map-entropy and --reverse score one trajectory: --est must be a file");
@@ -271,7 +295,8 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
   elo::TrajectoryEvaluation evaluation;
   try {
     evaluation = elo::evaluateTrajectory(files.name, ground_truth, estimate, options.segment_lengths,
-                                            options.segment_step);
+                                         options.segment_step,
+                                         rangesFrom(options.excluded_frames, options.start.value_or(0)));
     for (size_t pose : options.pose_errors) {
       pose_errors.push_back({files.name, pose, elo::poseErrorFromFirst(ground_truth, estimate, pose)});
     }
@@ -333,6 +358,12 @@ int run(const Options& options) {
   std::vector<PoseErrorRow> pose_errors;
   for (const SequenceFiles& files : sequences) {
     evaluations.push_back(evaluateFiles(files, options, directories, pose_errors));
+  }
+  if (!options.excluded_frames.empty()) {
+    const elo::TrajectoryEvaluation& evaluation = evaluations.front();
+    std::cerr << "elo_eval: " << evaluation.segments_left_out << " of "
+              << evaluation.segments_left_out + evaluation.segments.size()
+              << " segments hold an excluded frame and are left out\n";
   }
   if (directories) {
     evaluations.push_back(elo::poolEvaluations("overall", evaluations));

@@ -25,10 +25,13 @@ double pooledRmse(const std::vector<Part>& parts, Rmse rmse_of, Count count_of) 
 
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
                                         const std::vector<Eigen::Isometry3d>& estimate,
-                                        const std::vector<double>& segment_lengths, size_t start_step) {
+                                        const std::vector<double>& segment_lengths, size_t start_step,
+                                        const std::vector<FrameRange>& excluded_frames) {
   TrajectoryEvaluation evaluation;
   evaluation.name = name;
-  evaluation.segments = kittiSegmentErrors(ground_truth, estimate, segment_lengths, start_step);
+  const std::vector<SegmentError> segments = kittiSegmentErrors(ground_truth, estimate, segment_lengths, start_step);
+  evaluation.segments = segmentsClearOf(segments, excluded_frames);
+  evaluation.segments_left_out = segments.size() - evaluation.segments.size();
   evaluation.frames = ground_truth.size();
   const std::vector<double> distances = trajectoryDistances(ground_truth);
   evaluation.length_m = distances.empty() ? 0.0 : distances.back();
@@ -47,6 +50,7 @@ TrajectoryEvaluation poolEvaluations(const std::string& name, const std::vector<
     pooled.frames += sequence.frames;
     pooled.length_m += sequence.length_m;
     pooled.segments.insert(pooled.segments.end(), sequence.segments.begin(), sequence.segments.end());
+    pooled.segments_left_out += sequence.segments_left_out;
     pooled.components.insert(pooled.components.end(), sequence.components.begin(), sequence.components.end());
     pooled.rpe.pairs += sequence.rpe.pairs;
     pooled.ate.frames += sequence.ate.frames;

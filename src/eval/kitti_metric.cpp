@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <string>
 #include <stdexcept>
 
 #include "relative_motion.hpp"
@@ -70,6 +71,41 @@ std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d
     }
   }
   return segments;
+}
+
+std::vector<FrameRange> parseFrameRanges(const std::string& text) {
+  const auto frame = [](const std::string& item, const std::string& number) {
+    // At most 18 digits: a frame number, never past what size_t holds.
+    const bool digits = !number.empty() && number.size() <= 18 &&
+                        number.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits) throw std::invalid_argument("expected frames A-B or A, got '" + item + "'");
+    return static_cast<size_t>(std::stoull(number));
+  };
+  std::vector<FrameRange> ranges;
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    const size_t comma = std::min(text.find(',', begin), text.size());
+    const std::string item = text.substr(begin, comma - begin);
+    const size_t dash = item.find('-');
+    const size_t first = frame(item, item.substr(0, dash));
+    const size_t last = dash == std::string::npos ? first : frame(item, item.substr(dash + 1));
+    if (last < first) throw std::invalid_argument("expected A <= B in frames A-B, got '" + item + "'");
+    ranges.push_back({first, last});
+    begin = comma + 1;
+  }
+  return ranges;
+}
+
+std::vector<SegmentError> segmentsClearOf(const std::vector<SegmentError>& segments,
+                                          const std::vector<FrameRange>& excluded) {
+  const auto holds_excluded_frame = [&excluded](const SegmentError& segment) {
+    return std::any_of(excluded.begin(), excluded.end(), [&segment](const FrameRange& range) {
+      return range.first <= segment.last_frame && segment.first_frame <= range.last;
+    });
+  };
+  std::vector<SegmentError> clear;
+  std::remove_copy_if(segments.begin(), segments.end(), std::back_inserter(clear), holds_excluded_frame);
+  return clear;
 }
 
 DriftError averageDrift(const std::vector<SegmentError>& segments) {

@@ -177,6 +177,45 @@ TEST_F(EloEvalCli, GroundTruthTimesMoveItToTheScansInstants) {
   EXPECT_EQ(runEloEval(files + " --tum --gt-times " + directory_.file("times.txt")).exit_code, 2);
 }
 
+// A ground truth that strays 0.5 m sideways over frames 600-649 of the circle: --exclude-frames leaves the
+// segments holding them out, in the ground truth's frames with --start too.
+TEST_F(EloEvalCli, ExcludedFramesLeaveTheirSegmentsOut) {
+  std::vector<Eigen::Isometry3d> straying = ground_truth_;
+  for (size_t i = 600; i < 650; ++i) straying[i].translation().y() += 0.5;
+  writeKittiPoses(directory_.file("straying.txt"), straying);
+  writeKittiPoses(directory_.file("exact.txt"), ground_truth_);
+  const std::string files = "--gt " + directory_.file("straying.txt") + " --est " + directory_.file("exact.txt") +
+                            " --segments 10,50 --segment-step 1";
+  const auto t_rel = [](const std::string& output) { return std::stod(fieldsOfRow(output, "exact ").at(3)); };
+  const CommandResult all = runEloEval(files);
+  EXPECT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_GT(t_rel(all.output), 0.05) << all.output;
+  const CommandResult clear = runEloEval(files + " --exclude-frames 600-649");
+  EXPECT_EQ(clear.exit_code, 0) << clear.output;
+  EXPECT_NEAR(t_rel(clear.output), 0.0, 1e-6) << clear.output;
+  EXPECT_TRUE(contains(clear.output, "segments hold an excluded frame and are left out")) << clear.output;
+  // Single frames and ranges together: 600-649 given as 600,601-649.
+  EXPECT_NEAR(t_rel(runEloEval(files + " --exclude-frames 600,601-649").output), 0.0, 1e-6);
+  // Frames 500-899 scored from ground-truth frame 500 on: the stray is still at the ground truth's 600-649.
+  writeKittiPoses(directory_.file("from_500.txt"),
+                  std::vector<Eigen::Isometry3d>(ground_truth_.begin() + 500, ground_truth_.begin() + 900));
+  const std::string from_500 = "--gt " + directory_.file("straying.txt") + " --est " + directory_.file("from_500.txt") +
+                               " --segments 10,50 --segment-step 1 --start 500";
+  const auto t_rel_from_500 = [](const std::string& output) {
+    return std::stod(fieldsOfRow(output, "from_500 ").at(3));
+  };
+  EXPECT_GT(t_rel_from_500(runEloEval(from_500).output), 0.05);
+  EXPECT_NEAR(t_rel_from_500(runEloEval(from_500 + " --exclude-frames 600-649").output), 0.0, 1e-6);
+  EXPECT_GT(t_rel_from_500(runEloEval(from_500 + " --exclude-frames 100-149").output), 0.05);
+  for (const char* bad : {"649-600", "x", "600-", "-5", ""}) {
+    EXPECT_EQ(runEloEval(files + " --exclude-frames '" + bad + "'").exit_code, 2) << bad;
+  }
+  EXPECT_EQ(runEloEval("--gt " + directory_.file("gt") + " --est " + directory_.file("est") + " --exclude-frames 1-2")
+                .exit_code,
+            2)
+      << "directories";
+}
+
 TEST_F(EloEvalCli, TumFiles) {
   std::vector<double> stamps;
   for (size_t i = 0; i < ground_truth_.size(); ++i) stamps.push_back(0.1 * static_cast<double>(i));

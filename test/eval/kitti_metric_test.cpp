@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "synthetic_trajectories.hpp"
@@ -75,6 +76,44 @@ TEST(KittiMetric, SegmentStartsAreTheCallersChoice) {
   for (size_t i = 0; i < segments.size(); ++i) EXPECT_EQ(segments[i].first_frame, i);
   EXPECT_NEAR(averageDrift(segments).t_rel_percent, 1.0, 1e-6);
   EXPECT_THROW(kittiSegmentErrors(ground_truth, ground_truth, {10}, 0), std::invalid_argument);
+}
+
+// A ground truth that strays 0.5 m sideways over frames 400-449 while the estimate drives straight on:
+// the segments holding one of those frames are left out, and the others score nothing.
+TEST(KittiMetric, SegmentsClearOfExcludedFramesLeaveAStrayingGroundTruthOut) {
+  const std::vector<Eigen::Isometry3d> estimate = test::straightLine(kFrames, kSpacing);
+  std::vector<Eigen::Isometry3d> ground_truth = estimate;
+  for (size_t i = 400; i < 450; ++i) ground_truth[i].translation().y() += 0.5;
+  const std::vector<SegmentError> segments = kittiSegmentErrors(ground_truth, estimate, {10}, 1);
+  EXPECT_GT(averageDrift(segments).t_rel_percent, 0.1);
+  const std::vector<SegmentError> clear = segmentsClearOf(segments, {{400, 449}});
+  EXPECT_NEAR(averageDrift(clear).t_rel_percent, 0.0, 1e-9);
+  const auto kept = [&clear](size_t first) {
+    return std::any_of(clear.begin(), clear.end(), [first](const SegmentError& s) { return s.first_frame == first; });
+  };
+  EXPECT_TRUE(kept(389)) << "frames 389-399";
+  EXPECT_FALSE(kept(390)) << "frames 390-400";
+  EXPECT_FALSE(kept(449));
+  EXPECT_TRUE(kept(450));
+  // 10 m segments starting at every frame before the last 10: those starting 390-449 are left out.
+  EXPECT_EQ(clear.size(), segments.size() - 60);
+  EXPECT_EQ(segmentsClearOf(segments, {}).size(), segments.size());
+  EXPECT_EQ(segmentsClearOf(segments, {{0, kFrames}}).size(), 0u);
+  EXPECT_TRUE(std::isnan(averageDrift(segmentsClearOf(segments, {{0, kFrames}})).t_rel_percent));
+}
+
+TEST(KittiMetric, FrameRangesAreReadFromText) {
+  const std::vector<FrameRange> ranges = parseFrameRanges("0-30,32,48-88");
+  ASSERT_EQ(ranges.size(), 3u);
+  EXPECT_EQ(ranges[0].first, 0u);
+  EXPECT_EQ(ranges[0].last, 30u);
+  EXPECT_EQ(ranges[1].first, 32u);
+  EXPECT_EQ(ranges[1].last, 32u);
+  EXPECT_EQ(ranges[2].first, 48u);
+  EXPECT_EQ(ranges[2].last, 88u);
+  for (const char* bad : {"", "5-3", "x", "1-", "-1", "1,,2", "1 -2", "+1", "1234567890123456789012"}) {
+    EXPECT_THROW(parseFrameRanges(bad), std::invalid_argument) << bad;
+  }
 }
 
 TEST(KittiMetric, ScaledIncrementsOnAStraightLineGiveOnePercent) {

@@ -6,11 +6,13 @@
 // looked, when its drive is absent.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <algorithm>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -145,6 +147,40 @@ INSTANTIATE_TEST_SUITE_P(Drives, RealDriveDrift,
                          testing::Values(DriftCase{"0001", 0.429, 0.346}, DriftCase{"0002", 0.561, 0.592},
                                          DriftCase{"0005", 5.098, 1.406}, DriftCase{"0027", 1.383, 0.226}),
                          [](const auto& info) { return std::string("drive_") + info.param.drive; });
+
+// The scans of a drive where the ground truth's direction of travel strays from what OXTS's own speed and
+// yaw rate give (tools/oxts_consistency.py --strays); none where it holds together.
+std::vector<FrameRange> strayingScans(const std::string& drive) {
+  const std::string command = "/usr/bin/python3 " + std::string(ELO_SOURCE_DIR) + "/tools/oxts_consistency.py --strays " +
+                              drivePath(drive) + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("cannot run " + command);
+  std::string output;
+  for (char buffer[256]; std::fgets(buffer, sizeof buffer, pipe) != nullptr;) output += buffer;
+  if (pclose(pipe) != 0) throw std::runtime_error(command + " failed: " + output);
+  const std::string ranges = output.substr(0, output.find('\n'));
+  return ranges.empty() ? std::vector<FrameRange>{} : parseFrameRanges(ranges);
+}
+
+// 0005's ground truth strays over more than half of its scans (docs/real_drives.md): over the segments
+// clear of them ELO stays within a little of today's figures there, which meet issue 43's targets (t_rel
+// no higher than KISS-ICP's 4.69 %, 3.59 % on the same segments; r_rel at most half of its 2.15
+// deg/100 m, 2.21 on the same segments).
+TEST(RealDriveClearSegments, Drive0005StaysWithinTodaysFiguresWhereItsTruthHoldsTogether) {
+  const std::string drive = "0005";
+  if (!driveIsPresent(drive)) GTEST_SKIP() << absentMessage(drive);
+  const std::vector<FrameRange> strays = strayingScans(drive);
+  ASSERT_FALSE(strays.empty()) << "0005's ground truth strays over scans 0-30, 32-42 and 48-88";
+  const DriveRun& run = wholeDrive(drive);
+  const std::vector<SegmentError> segments = kittiSegmentErrors(run.ground_truth, run.estimate, kSegmentLengths, kSegmentStep);
+  const DriftError drift = averageDrift(segmentsClearOf(segments, strays));
+  std::cout << "drive 0005, segments clear of the truth's strays: t_rel " << drift.t_rel_percent << " %, r_rel "
+            << drift.r_rel_deg_per_100m << " deg/100m over " << drift.segments << " of " << segments.size()
+            << " segments" << std::endl;
+  EXPECT_GE(drift.segments, 60u);
+  EXPECT_LT(drift.t_rel_percent, kHeadroom * 3.260);
+  EXPECT_LT(drift.r_rel_deg_per_100m, kHeadroom * 0.867);
+}
 
 // A run started on a moving car: ELO at its first scan knows nothing of the motion, yet its 2nd scan
 // must be within 0.10 m of the truth (relative to the 1st), the start search's doing

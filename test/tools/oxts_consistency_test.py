@@ -2,7 +2,8 @@
 """tools/oxts_consistency.py on a synthetic drive: a car on a circle at 10 m/s turning at 0.05 rad/s,
 its OXTS yaw rate exact. The ground truth agrees with the yaw rate and travels along its heading and its
 x axis; an odometry that turns 0.01 deg a scan too far is 0.5 deg off the yaw rate over a window of 50
-scans, and one that climbs 1 m in 100 with its x axis level travels 0.573 deg above it."""
+scans, and one that climbs 1 m in 100 with its x axis level travels 0.573 deg above it. --strays finds
+where a ground truth's positions slide sideways under an unchanged heading."""
 import os
 import subprocess
 import sys
@@ -40,6 +41,20 @@ def rows_of(output):
     return rows
 
 
+def write_drive(drive, poses, speed, yaw_rate):
+    np.savetxt(os.path.join(drive, "poses.txt"), poses)
+    np.savetxt(os.path.join(drive, "times.txt"), PERIOD * np.arange(SCANS))
+    oxts = np.zeros((SCANS, 9))
+    oxts[:, 6] = speed
+    oxts[:, 8] = yaw_rate
+    np.savetxt(os.path.join(drive, "oxts.txt"), oxts)
+
+
+def strays(drive):
+    done = subprocess.run([sys.executable, TOOL, "--strays", drive], capture_output=True, text=True)
+    return done.returncode, done.stdout.strip(), done.stderr
+
+
 class OxtsConsistency(unittest.TestCase):
     def test_exact_drive_and_an_odometry_that_turns_too_far(self):
         with tempfile.TemporaryDirectory() as drive:
@@ -65,6 +80,42 @@ class OxtsConsistency(unittest.TestCase):
             self.assertAlmostEqual(rows["climbs_level.txt"][0], 0.0, places=6)
             # The chord of 5 scans of the circle is a little shorter than its arc: 0.573 deg to 0.01.
             self.assertAlmostEqual(rows["climbs_level.txt"][4], np.degrees(np.arctan(0.01)), places=2)
+
+    def test_strays_where_the_positions_slide_sideways(self):
+        with tempfile.TemporaryDirectory() as drive:
+            # On the circle the truth travels along its heading: what OXTS's yaw rate gives a sensor ahead
+            # of the turning centre is a steady angle, taken off with the drive's median. Nothing strays.
+            write_drive(drive, circle_poses(), SPEED, YAW_RATE)
+            self.assertEqual(strays(drive)[:2], (0, ""))
+            # Straight along x at 1 m a scan, the positions sliding 0.1 m sideways a scan over scans 50-70
+            # (5.7 deg) under an unchanged heading: a window of 5 scans holding 3 or more of those 20
+            # slides (3.4 deg and more) strays, those starting at scans 48-67, which cover scans 48-72.
+            straight = np.tile(np.eye(4)[:3, :].reshape(-1), (SCANS, 1))
+            straight[:, 3] = np.arange(SCANS)
+            straight[:, 7] = 0.1 * np.clip(np.arange(SCANS) - 50, 0, 20)
+            write_drive(drive, straight, 10.0, 0.0)
+            returncode, ranges, report = strays(drive)
+            self.assertEqual(returncode, 0, report)
+            self.assertEqual(ranges, "48-72")
+            self.assertIn("25 of 120 scans", report)
+            # Two stretches, comma-separated as elo_eval --exclude-frames reads them.
+            straight[:, 7] += 0.1 * np.clip(np.arange(SCANS) - 100, 0, 10)
+            write_drive(drive, straight, 10.0, 0.0)
+            self.assertEqual(strays(drive)[1], "48-72,98-112")
+
+    def test_strays_needs_an_oxts_row_a_pose(self):
+        with tempfile.TemporaryDirectory() as drive:
+            write_drive(drive, circle_poses(), SPEED, YAW_RATE)
+            np.savetxt(os.path.join(drive, "oxts.txt"), np.zeros((SCANS - 1, 9)))
+            returncode, _, report = strays(drive)
+            self.assertEqual(returncode, 2)
+            self.assertIn("oxts.txt has 119 rows for 120 poses", report)
+            self.assertEqual(strays(os.path.join(drive, "nowhere"))[0], 2)
+            np.savetxt(os.path.join(drive, "poses.txt"), circle_poses()[:5])
+            np.savetxt(os.path.join(drive, "oxts.txt"), np.zeros((5, 9)))
+            returncode, _, report = strays(drive)
+            self.assertEqual(returncode, 2)
+            self.assertIn("5 scans, too few for windows of 5", report)
 
     def test_a_trajectory_of_other_scans_is_refused(self):
         with tempfile.TemporaryDirectory() as drive:

@@ -17,6 +17,7 @@ struct TrajectoryEvaluation {
   size_t frames = 0;
   double length_m = 0.0;  // ground-truth path length
   std::vector<SegmentError> segments;
+  size_t segments_left_out = 0;  // those holding an excluded frame
   DriftError drift;
   std::vector<SegmentComponents> components;  // of each segment
   ErrorBreakdown breakdown;
@@ -24,12 +25,14 @@ struct TrajectoryEvaluation {
   AbsoluteTrajectoryError ate;
 };
 
-// The KITTI metric over segments of `segment_lengths` (m) starting every `start_step` frames. Throws
+// The KITTI metric over segments of `segment_lengths` (m) starting every `start_step` frames, those
+// holding a frame of `excluded_frames` left out (RPE and ATE keep every frame). Throws
 // std::invalid_argument naming both counts when the trajectories have different lengths.
 TrajectoryEvaluation evaluateTrajectory(const std::string& name, const std::vector<Eigen::Isometry3d>& ground_truth,
                                         const std::vector<Eigen::Isometry3d>& estimate,
                                         const std::vector<double>& segment_lengths = kittiSegmentLengths(),
-                                        size_t start_step = kKittiStartFrameStep);
+                                        size_t start_step = kKittiStartFrameStep,
+                                        const std::vector<FrameRange>& excluded_frames = {});
 
 // The figures over all sequences: KITTI drift and its breakdown over the segments of all of them (as the
 // devkit pools), RPE over all frame pairs and ATE over all frames (each sequence aligned on its own, so

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace elo {
@@ -49,6 +50,21 @@ std::vector<SegmentError> kittiSegmentErrors(const std::vector<Eigen::Isometry3d
                                              const std::vector<Eigen::Isometry3d>& estimate,
                                              const std::vector<double>& lengths = kittiSegmentLengths(),
                                              size_t start_step = kKittiStartFrameStep);
+
+// A run of frames, both ends included.
+struct FrameRange {
+  size_t first = 0;
+  size_t last = 0;
+};
+
+// "A-B,C,...": ranges of frames, both ends included, or single frames (elo_eval --exclude-frames,
+// tools/oxts_consistency.py --strays). Throws std::invalid_argument naming the item it cannot read.
+std::vector<FrameRange> parseFrameRanges(const std::string& text);
+
+// The segments that hold no frame of `excluded`: the metric over the stretches of a drive whose ground
+// truth holds together (docs/real_drives.md: OXTS's direction of travel strays on parts of drive 0005).
+std::vector<SegmentError> segmentsClearOf(const std::vector<SegmentError>& segments,
+                                          const std::vector<FrameRange>& excluded);
 
 // The mean over `segments`; the devkit's overall figure pools the segments of all sequences this way.
 DriftError averageDrift(const std::vector<SegmentError>& segments);
