@@ -16,16 +16,16 @@
 #     ground truth rebased to its first scan (elo_eval --start S --pose-errors 1,10), beside the 11th
 #     pose's error of the drive's own run over the same scans (tracking, no start).
 # Usage:
-#   [START_EVERY=N] [THREADS=N] tools/accuracy_real.sh BUILD_DIR DRIVES_DIR [f2m|f2f]
-# Works in BUILD_DIR/accuracy_real/ (trajectories kept); the tables are also written to
-# BUILD_DIR/accuracy_real/table.txt. Exits 0, saying where it looked, when DRIVES_DIR holds no drive.
+#   [START_EVERY=N] [THREADS=N] [ACCURACY_REAL_OUTPUT=DIR] tools/accuracy_real.sh BUILD_DIR DRIVES_DIR [f2m|f2f]
+# Works in ACCURACY_REAL_OUTPUT (default BUILD_DIR/accuracy_real/, emptied first; trajectories kept); the
+# tables are also written to table.txt there. Exits 0, saying where it looked, when DRIVES_DIR holds no drive.
 set -euo pipefail
 build=${1:-build}
 drives_dir=${2:-../real_drives}
 mode=${3:-f2m}
 bin="$build/devel/lib/elo_odometry"
 config="$(dirname "$0")/../config/kitti.yaml"
-work="$build/accuracy_real"
+work=${ACCURACY_REAL_OUTPUT:-$build/accuracy_real}
 segments=10,20,50,100
 # A segment starts at every scan: these drives are 108-188 scans long, too few for the devkit's every 10th.
 segment_step=1
