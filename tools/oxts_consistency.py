@@ -127,7 +127,7 @@ def print_strays(drive):
     flags = np.zeros(len(poses), dtype=bool)
     for i in np.flatnonzero(np.abs(np.nan_to_num(off)) > STRAY_DEG):
         flags[i:i + TRAVEL_WINDOW + 1] = True
-    print(frame_ranges(flags))
+    print(frame_ranges(flags), flush=True)  # before the report on stderr, where both go to one pipe
     print(f"oxts_consistency: {flags.sum()} of {len(poses)} scans in windows straying more than {STRAY_DEG} deg "
           f"(rms {np.sqrt(np.nanmean(off ** 2)):.2f} deg)", file=sys.stderr)
 
