@@ -151,8 +151,8 @@ INSTANTIATE_TEST_SUITE_P(Drives, RealDriveDrift,
 // The scans of a drive where the ground truth's direction of travel strays from what OXTS's own speed and
 // yaw rate give (tools/oxts_consistency.py --strays); none where it holds together.
 std::vector<FrameRange> strayingScans(const std::string& drive) {
-  const std::string command = "/usr/bin/python3 " + std::string(ELO_SOURCE_DIR) + "/tools/oxts_consistency.py --strays " +
-                              drivePath(drive) + " 2>&1";
+  const std::string command = "/usr/bin/python3 " + std::string(ELO_SOURCE_DIR) +
+                              "/tools/oxts_consistency.py --strays " + drivePath(drive) + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("cannot run " + command);
   std::string output;
@@ -172,7 +172,8 @@ TEST(RealDriveClearSegments, Drive0005StaysWithinTodaysFiguresWhereItsTruthHolds
   const std::vector<FrameRange> strays = strayingScans(drive);
   ASSERT_FALSE(strays.empty()) << "0005's ground truth strays over scans 0-30, 32-42 and 48-88";
   const DriveRun& run = wholeDrive(drive);
-  const std::vector<SegmentError> segments = kittiSegmentErrors(run.ground_truth, run.estimate, kSegmentLengths, kSegmentStep);
+  const std::vector<SegmentError> segments =
+      kittiSegmentErrors(run.ground_truth, run.estimate, kSegmentLengths, kSegmentStep);
   const DriftError drift = averageDrift(segmentsClearOf(segments, strays));
   std::cout << "drive 0005, segments clear of the truth's strays: t_rel " << drift.t_rel_percent << " %, r_rel "
             << drift.r_rel_deg_per_100m << " deg/100m over " << drift.segments << " of " << segments.size()
