@@ -101,6 +101,16 @@ struct Options {
 
 using elo::tools::UsageError;
 
+// --exclude-frames must name frames of the ground truth: a range past its end is another drive's.
+void requireFramesOf(const std::vector<elo::FrameRange>& ranges, size_t poses, const std::string& path) {
+  for (const elo::FrameRange& range : ranges) {
+    if (range.last >= poses) {
+      throw elo::IoError("--exclude-frames " + std::to_string(range.first) + "-" + std::to_string(range.last) +
+                         ": '" + path + "' has " + std::to_string(poses) + " poses");
+    }
+  }
+}
+
 // Frame ranges of the ground-truth file as frames of its part from `start` on (--start).
 std::vector<elo::FrameRange> rangesFrom(const std::vector<elo::FrameRange>& ranges, size_t start) {
   std::vector<elo::FrameRange> shifted;
@@ -288,6 +298,7 @@ elo::TrajectoryEvaluation evaluateFiles(const SequenceFiles& files, const Option
                                         std::vector<PoseErrorRow>& pose_errors) {
   const std::vector<Eigen::Isometry3d> estimate = readTrajectory(files.estimate, options.tum);
   std::vector<Eigen::Isometry3d> ground_truth = readTrajectory(files.ground_truth, options.tum);
+  requireFramesOf(options.excluded_frames, ground_truth.size(), files.ground_truth);
   if (options.ground_truth_times) {
     ground_truth = atUniformInstants(ground_truth, files.ground_truth, *options.ground_truth_times);
   }

@@ -210,6 +210,10 @@ TEST_F(EloEvalCli, ExcludedFramesLeaveTheirSegmentsOut) {
   for (const char* bad : {"649-600", "x", "600-", "-5", ""}) {
     EXPECT_EQ(runEloEval(files + " --exclude-frames '" + bad + "'").exit_code, 2) << bad;
   }
+  const CommandResult beyond = runEloEval(files + " --exclude-frames 600-649,1190-1200");
+  EXPECT_EQ(beyond.exit_code, 2);
+  EXPECT_TRUE(contains(beyond.output, "--exclude-frames 1190-1200: ")) << beyond.output;
+  EXPECT_TRUE(contains(beyond.output, "has 1200 poses")) << beyond.output;
   EXPECT_EQ(runEloEval("--gt " + directory_.file("gt") + " --est " + directory_.file("est") + " --exclude-frames 1-2")
                 .exit_code,
             2)
