@@ -73,17 +73,25 @@ def pitch_deg(rotation):
     return np.degrees(np.arctan2(-rotation[2, 0], rotation[0, 0]))
 
 
+def travel_off_heading_deg(step):
+    """The direction of travel over a window's motion `step` off its heading (half the window's turn taken
+    off); None standing still, with no direction of travel."""
+    if np.linalg.norm(step[:2, 3]) < 0.5:
+        return None
+    return np.degrees(np.arctan2(step[1, 3], step[0, 3])) - yaw_deg(step[:3, :3]) / 2.0
+
+
 def travel_off_axes(poses):
     """Per window of TRAVEL_WINDOW scans: the direction of travel off the heading and above the x axis."""
     sideways, upwards = [], []
     for i in range(0, len(poses) - TRAVEL_WINDOW, TRAVEL_WINDOW):
         step = relative(poses, i, i + TRAVEL_WINDOW)
-        horizontal = np.linalg.norm(step[:2, 3])
-        if horizontal < 0.5:  # standing still: no direction of travel
+        off_heading = travel_off_heading_deg(step)
+        if off_heading is None:
             continue
-        sideways.append(np.degrees(np.arctan2(step[1, 3], step[0, 3])) - yaw_deg(step[:3, :3]) / 2.0)
+        sideways.append(off_heading)
         # The x axis pitches nose down for a positive pitch: half the window's pitch change turns it up.
-        upwards.append(np.degrees(np.arctan2(step[2, 3], horizontal)) + pitch_deg(step[:3, :3]) / 2.0)
+        upwards.append(np.degrees(np.arctan2(step[2, 3], np.linalg.norm(step[:2, 3]))) + pitch_deg(step[:3, :3]) / 2.0)
     return np.array(sideways), np.array(upwards)
 
 
@@ -94,12 +102,12 @@ def travel_off_oxts_deg(poses, oxts):
     speed, yaw_rate = oxts[:, 6], oxts[:, 8]
     angles = np.full(len(poses) - TRAVEL_WINDOW, np.nan)
     for i in range(len(angles)):
-        step = relative(poses, i, i + TRAVEL_WINDOW)
-        if np.linalg.norm(step[:2, 3]) < 0.5:
+        off_heading = travel_off_heading_deg(relative(poses, i, i + TRAVEL_WINDOW))
+        if off_heading is None:
             continue
         window = slice(i, i + TRAVEL_WINDOW + 1)
         lever_angle = np.degrees(np.arctan2(LEVER_M * yaw_rate[window].mean(), speed[window].mean()))
-        angles[i] = np.degrees(np.arctan2(step[1, 3], step[0, 3])) - yaw_deg(step[:3, :3]) / 2.0 - lever_angle
+        angles[i] = off_heading - lever_angle
     return angles
 
 
