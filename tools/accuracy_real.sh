@@ -61,11 +61,11 @@ strayingScans() {
 }
 
 # truthAt DRIVE TRUTH: elo_eval's options for the ground truth at its stamps, at the scans' instants, or
-# at its stamps over the segments clear of its strays.
+# at its stamps over the segments clear of its strays (the drive table's loop finds them, in `strays`).
 truthAt() {
   case $2 in
     instants) echo "--gt $1/poses.txt --gt-times $1/times.txt" ;;
-    clear) echo "--gt $1/poses.txt --exclude-frames $(strayingScans "$1")" ;;
+    clear) echo "--gt $1/poses.txt --exclude-frames $strays" ;;
     *) echo "--gt $1/poses.txt" ;;
   esac
 }
@@ -84,12 +84,12 @@ score() {
     tee -a "$table"
 }
 
-# The ground truth at the scans' instants needs the stamps, times.txt; its clear segments a drive where it
-# strays.
+# truths DRIVE STRAYS: the ground truth at the scans' instants needs the stamps, times.txt; its clear
+# segments a drive where it strays.
 truths() {
   echo stamps
   if [ -f "$1/times.txt" ]; then echo instants; fi
-  if [ -n "$(strayingScans "$1")" ]; then echo clear; fi
+  if [ -n "$2" ]; then echo clear; fi
 }
 
 printf '%-6s %-7s %-8s %6s %9s %8s %15s %8s %7s %9s %7s %7s %8s %8s %9s\n' drive method truth scans length_m 't_rel_%' \
@@ -101,7 +101,8 @@ for drive in "${drives[@]}"; do
   if [ -n "${KISS_RUN:-}" ]; then
     "$KISS_RUN" "$drive/velodyne" --output "$work/${name}_kiss.txt" --threads "$threads" >"$work/${name}_kiss.log"
   fi
-  for truth in $(truths "$drive"); do
+  strays=$(strayingScans "$drive")
+  for truth in $(truths "$drive" "$strays"); do
     score "$drive" "elo-$mode" "$work/$name.txt" "$truth"
     [ -z "${KISS_RUN:-}" ] || score "$drive" kiss-icp "$work/${name}_kiss.txt" "$truth"
   done
